@@ -1,0 +1,131 @@
+"""Car paths as at most five arc/straight segments — the one representation of a local motion.
+
+Dubins and Reeds-Shepp words are both written as ``kinds`` (int8[5]: +1 left arc, 0 straight,
+-1 right arc) and ``lens`` (float64[5]: signed arc length in metres, negative = reversing; unused
+slots are 0). Arcs have radius ``rho``. Everything downstream — sampling, collision checks,
+curvature profiles — reads only this form, so both steering functions share one integrator.
+
+The pose update along a segment is exact (no numerical integration): for a left arc of signed
+length l, θ' = θ + l/ρ, x' = x + ρ(sin θ' − sin θ), y' = y − ρ(cos θ' − cos θ).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+MAX_SEGMENTS = 5
+LEFT, STRAIGHT, RIGHT = 1, 0, -1
+
+
+@njit(cache=True, inline="always")
+def advance(x: float, y: float, th: float, kind: int, length: float, rho: float):
+    """Pose after driving ``length`` (signed) on one segment of ``kind`` from (x, y, th)."""
+    if kind == 0:
+        return x + length * math.cos(th), y + length * math.sin(th), th
+    th2 = th + kind * length / rho
+    x2 = x + kind * rho * (math.sin(th2) - math.sin(th))
+    y2 = y - kind * rho * (math.cos(th2) - math.cos(th))
+    return x2, y2, th2
+
+
+@njit(cache=True)
+def path_length(lens: np.ndarray) -> float:
+    """Driven length of a path: the sum of |segment length|."""
+    total = 0.0
+    for i in range(lens.shape[0]):
+        total += abs(lens[i])
+    return total
+
+
+@njit(cache=True)
+def pose_at(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray, rho: float,
+            s: float):
+    """Pose at driven length ``s`` (0 ≤ s ≤ path length) along the path from (x, y, th).
+
+    Returns (x, y, theta, kind, direction) where kind is the segment's steering (+1/0/-1) and
+    direction +1 forward, -1 reverse at that point.
+    """
+    remaining = s
+    kind = 0
+    direction = 1.0
+    for i in range(kinds.shape[0]):
+        seg = lens[i]
+        if seg == 0.0:
+            continue
+        kind = kinds[i]
+        direction = 1.0 if seg > 0.0 else -1.0
+        if remaining <= abs(seg):
+            x, y, th = advance(x, y, th, kind, direction * remaining, rho)
+            return x, y, th, kind, direction
+        x, y, th = advance(x, y, th, kind, seg, rho)
+        remaining -= abs(seg)
+    return x, y, th, kind, direction
+
+
+@njit(cache=True)
+def path_end(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray, rho: float):
+    """End pose of the path (heading not wrapped)."""
+    for i in range(kinds.shape[0]):
+        if lens[i] != 0.0:
+            x, y, th = advance(x, y, th, kinds[i], lens[i], rho)
+    return x, y, th
+
+
+@njit(cache=True)
+def truncate(kinds: np.ndarray, lens: np.ndarray, s: float, out_lens: np.ndarray) -> None:
+    """Write into ``out_lens`` the first ``s`` metres of the path (same kinds)."""
+    remaining = s
+    for i in range(kinds.shape[0]):
+        seg = lens[i]
+        take = min(abs(seg), max(remaining, 0.0))
+        out_lens[i] = take if seg >= 0.0 else -take
+        remaining -= take
+
+
+@njit(cache=True)
+def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray, rho: float,
+                spacing: float) -> np.ndarray:
+    """Poses every ≤ ``spacing`` metres, both ends and every segment joint included.
+
+    Returns an (n, 5) array of x, y, theta, curvature (steering curvature: kind/ρ), direction.
+    """
+    n = 1
+    for i in range(kinds.shape[0]):
+        if lens[i] != 0.0:
+            n += max(1, int(math.ceil(abs(lens[i]) / spacing - 1e-12)))
+    out = np.empty((n, 5))
+    out[0, 0] = x
+    out[0, 1] = y
+    out[0, 2] = th
+    first = -1
+    for i in range(kinds.shape[0]):
+        if lens[i] != 0.0:
+            first = i
+            break
+    out[0, 3] = kinds[first] / rho if first >= 0 else 0.0
+    out[0, 4] = 1.0 if first < 0 or lens[first] > 0.0 else -1.0
+    k = 1
+    for i in range(kinds.shape[0]):
+        seg = lens[i]
+        if seg == 0.0:
+            continue
+        steps = max(1, int(math.ceil(abs(seg) / spacing - 1e-12)))
+        for j in range(1, steps + 1):
+            px, py, pth = advance(x, y, th, kinds[i], seg * j / steps, rho)
+            out[k, 0] = px
+            out[k, 1] = py
+            out[k, 2] = pth
+            out[k, 3] = kinds[i] / rho
+            out[k, 4] = 1.0 if seg > 0.0 else -1.0
+            k += 1
+        x, y, th = advance(x, y, th, kinds[i], seg, rho)
+    return out
+
+
+@njit(cache=True, inline="always")
+def wrap_angle(a: float) -> float:
+    """Wrap to [-π, π)."""
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
