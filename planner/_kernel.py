@@ -1,0 +1,446 @@
+"""The compiled RRT / RRT* iteration (LaValle 1998; Karaman & Frazzoli 2011) for a car.
+
+Data live in flat arrays (`Tree`), positions in a uniform grid that grows with the tree. The
+Euclidean distance between positions is a lower bound of every car path length, so nearest and
+near queries scan grid cells outward and compute exact steering lengths only for the few nodes
+whose Euclidean distance can still beat the best so far (OMPL instead computes a Dubins length to
+every node, every iteration).
+
+Rewiring keeps the rewired child's full SE(2) state: with exact steering the new edge ends at
+exactly the old pose, so the subtree stays kinematically valid and only its costs (and, with
+moving obstacles, its arrival times) change. The seed thesis duplicated nodes instead, because
+its edges did not fix the heading; see docs/planner.md. With moving obstacles a rewire is taken
+only if every edge of the rewired subtree is still free at its new, earlier times.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from planner._paths import path_end, truncate, wrap_angle
+from planner._rng import uniform
+from planner._steer import steer_length, steer_path
+from planner._world import World, motion_free
+
+# Parameter vector indices.
+(EPS, GAMMA, GOAL_BIAS, RHO, SPEED, GX, GY, GTH, GPOS, GHEAD, INFORMED, STAR, REVERSE,
+ SX, SY, NPARAMS) = range(16)
+# Counter indices.
+N, NGOAL, ITER, CHECKS, BEST, REWIRES, EVALS, FIRST_ITER, REFUSED = range(9)
+# Event row columns (only written when the event buffers are non-empty).
+EV_ITER, EV_XR, EV_YR, EV_THR, EV_NEAREST, EV_NEW, EV_PARENT, EV_NEAR_START, EV_NEAR_END, \
+    EV_RADIUS, EV_BEST, EV_COLS = range(12)
+
+
+class Tree(NamedTuple):
+    pose: np.ndarray  # (cap, 3)
+    cost: np.ndarray  # (cap,) driven length from the root
+    parent: np.ndarray  # (cap,) int64, -1 for the root
+    kinds: np.ndarray  # (cap, 5) int8: the edge from the parent
+    lens: np.ndarray  # (cap, 5)
+    first_child: np.ndarray  # (cap,) int64
+    next_sibling: np.ndarray  # (cap,) int64
+    cell_head: np.ndarray  # (nx * ny,) int64
+    cell_next: np.ndarray  # (cap,) int64
+    grid: np.ndarray  # float64[5]: x0, y0, cell size, nx, ny
+    goal_nodes: np.ndarray  # (cap,) int64
+    cnt: np.ndarray  # int64[9], see the counter indices
+    rng: np.ndarray  # uint64[4]
+    near: np.ndarray  # scratch (cap,) int64
+    near_len: np.ndarray  # scratch (cap,)
+    near_key: np.ndarray  # scratch (cap,)
+    stack: np.ndarray  # scratch (cap,) int64
+
+
+class Events(NamedTuple):
+    """Per-iteration records for a visualiser; zero-length arrays switch recording off."""
+
+    rows: np.ndarray  # (cap, EV_COLS)
+    near: np.ndarray  # (cap,) int64, slices given by EV_NEAR_START:EV_NEAR_END
+    rewires: np.ndarray  # (cap, 4) int64: iteration, node, old parent, new parent
+    cnt: np.ndarray  # int64[3]: rows, near entries, rewires used
+
+
+def new_tree(capacity: int, grid: np.ndarray, rng: np.ndarray) -> Tree:
+    nx, ny = int(grid[3]), int(grid[4])
+    return Tree(
+        pose=np.zeros((capacity, 3)), cost=np.zeros(capacity),
+        parent=np.full(capacity, -1, np.int64), kinds=np.zeros((capacity, 5), np.int8),
+        lens=np.zeros((capacity, 5)), first_child=np.full(capacity, -1, np.int64),
+        next_sibling=np.full(capacity, -1, np.int64), cell_head=np.full(nx * ny, -1, np.int64),
+        cell_next=np.full(capacity, -1, np.int64), grid=grid,
+        goal_nodes=np.zeros(capacity, np.int64), cnt=np.zeros(9, np.int64), rng=rng,
+        near=np.zeros(capacity, np.int64), near_len=np.zeros(capacity),
+        near_key=np.zeros(capacity), stack=np.zeros(capacity, np.int64))
+
+
+def grown(tree: Tree, capacity: int) -> Tree:
+    """A copy of ``tree`` with room for ``capacity`` nodes (the grid is kept)."""
+    def pad(a, fill):
+        out = np.full((capacity,) + a.shape[1:], fill, dtype=a.dtype)
+        out[: a.shape[0]] = a
+        return out
+
+    return tree._replace(
+        pose=pad(tree.pose, 0.0), cost=pad(tree.cost, 0.0), parent=pad(tree.parent, -1),
+        kinds=pad(tree.kinds, 0), lens=pad(tree.lens, 0.0),
+        first_child=pad(tree.first_child, -1), next_sibling=pad(tree.next_sibling, -1),
+        cell_next=pad(tree.cell_next, -1), goal_nodes=pad(tree.goal_nodes, 0),
+        near=np.zeros(capacity, np.int64), near_len=np.zeros(capacity),
+        near_key=np.zeros(capacity), stack=np.zeros(capacity, np.int64))
+
+
+@njit(cache=True, inline="always")
+def _cell(tree: Tree, x: float, y: float):
+    g = tree.grid
+    i = min(max(int((x - g[0]) / g[2]), 0), int(g[3]) - 1)
+    j = min(max(int((y - g[1]) / g[2]), 0), int(g[4]) - 1)
+    return i, j
+
+
+@njit(cache=True)
+def add_node(tree: Tree, P: np.ndarray, x, y, th, cost, parent, kinds, lens) -> int:
+    """Append a node (the caller has checked capacity); returns its index."""
+    k = tree.cnt[N]
+    tree.pose[k, 0] = x
+    tree.pose[k, 1] = y
+    tree.pose[k, 2] = th
+    tree.cost[k] = cost
+    tree.parent[k] = parent
+    tree.kinds[k, :] = kinds
+    tree.lens[k, :] = lens
+    tree.first_child[k] = -1
+    if parent >= 0:
+        tree.next_sibling[k] = tree.first_child[parent]
+        tree.first_child[parent] = k
+    i, j = _cell(tree, x, y)
+    c = i * int(tree.grid[4]) + j
+    tree.cell_next[k] = tree.cell_head[c]
+    tree.cell_head[c] = k
+    tree.cnt[N] = k + 1
+    if (math.hypot(x - P[GX], y - P[GY]) <= P[GPOS]
+            and abs(wrap_angle(th - P[GTH])) <= P[GHEAD]):
+        tree.goal_nodes[tree.cnt[NGOAL]] = k
+        tree.cnt[NGOAL] += 1
+    return k
+
+
+@njit(cache=True)
+def _sample(tree: Tree, w: World, P: np.ndarray):
+    """Goal-biased uniform sample; inside the informed ellipse once a solution exists."""
+    xmin, ymin, xmax, ymax = w.geo[0], w.geo[1], w.geo[2], w.geo[3]
+    th = (uniform(tree.rng) * 2.0 - 1.0) * math.pi
+    if uniform(tree.rng) < P[GOAL_BIAS]:
+        return P[GX], P[GY], P[GTH]
+    best = tree.cnt[BEST]
+    if P[INFORMED] > 0.0 and best >= 0:
+        # Any state on a cheaper path lies in the ellipse |x - s| + |x - g| <= c_best + tol.
+        diam = tree.cost[best] + P[GPOS]
+        fx, fy = P[GX] - P[SX], P[GY] - P[SY]
+        cmin = math.hypot(fx, fy)
+        a = 0.5 * diam
+        b = 0.5 * math.sqrt(max(diam * diam - cmin * cmin, 0.0))
+        if math.pi * a * b < (xmax - xmin) * (ymax - ymin):
+            c, s = (fx / cmin, fy / cmin) if cmin > 0.0 else (1.0, 0.0)
+            mx, my = 0.5 * (P[SX] + P[GX]), 0.5 * (P[SY] + P[GY])
+            for _ in range(100):
+                rad = math.sqrt(uniform(tree.rng))
+                phi = 2.0 * math.pi * uniform(tree.rng)
+                u, v = a * rad * math.cos(phi), b * rad * math.sin(phi)
+                x, y = mx + c * u - s * v, my + s * u + c * v
+                if xmin <= x <= xmax and ymin <= y <= ymax:
+                    return x, y, th
+    x = xmin + (xmax - xmin) * uniform(tree.rng)
+    y = ymin + (ymax - ymin) * uniform(tree.rng)
+    return x, y, th
+
+
+@njit(cache=True)
+def _scan_cell(tree: Tree, P, c, qx, qy, qth, best, besti):
+    node = tree.cell_head[c]
+    while node >= 0:
+        x, y = tree.pose[node, 0], tree.pose[node, 1]
+        if math.hypot(qx - x, qy - y) < best:
+            d = steer_length(P[REVERSE], x, y, tree.pose[node, 2], qx, qy, qth, P[RHO], best)
+            if d < best:
+                best, besti = d, node
+        node = tree.cell_next[node]
+    return best, besti
+
+
+@njit(cache=True)
+def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
+    """(node, steering length) of the tree node with the shortest car path to the query pose."""
+    n = tree.cnt[N]
+    best, besti = math.inf, -1
+    if n <= 32:
+        for node in range(n):
+            x, y = tree.pose[node, 0], tree.pose[node, 1]
+            d = steer_length(P[REVERSE], x, y, tree.pose[node, 2], qx, qy, qth, P[RHO], best)
+            if d < best:
+                best, besti = d, node
+        return besti, best
+    nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
+    ci, cj = _cell(tree, qx, qy)
+    for k in range(max(nx, ny) + 1):
+        if k >= 2 and (k - 1) * cell > best:
+            break
+        for i in range(ci - k, ci + k + 1):
+            if i < 0 or i >= nx:
+                continue
+            step = 2 * k if 0 < k and i != ci - k and i != ci + k else 1
+            j = cj - k
+            while j <= cj + k:
+                if 0 <= j < ny:
+                    best, besti = _scan_cell(tree, P, i * ny + j, qx, qy, qth, best, besti)
+                j += step
+    return besti, best
+
+
+@njit(cache=True)
+def _near(tree: Tree, x, y, radius) -> int:
+    """Fill tree.near / near_len with the nodes within Euclidean ``radius`` of (x, y).
+
+    Car path lengths are never shorter than the Euclidean distance, so this ball holds every
+    node within steering length ``radius`` in either direction; exact lengths come later, and
+    only for candidates whose bound can still pay off.
+    """
+    nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
+    ci, cj = _cell(tree, x, y)
+    k = int(math.ceil(radius / cell))
+    m = 0
+    for i in range(max(ci - k, 0), min(ci + k, nx - 1) + 1):
+        for j in range(max(cj - k, 0), min(cj + k, ny - 1) + 1):
+            node = tree.cell_head[i * ny + j]
+            while node >= 0:
+                d = math.hypot(tree.pose[node, 0] - x, tree.pose[node, 1] - y)
+                if d <= radius:
+                    tree.near[m] = node
+                    tree.near_len[m] = d
+                    m += 1
+                node = tree.cell_next[node]
+    return m
+
+
+@njit(cache=True)
+def _unlink_child(tree: Tree, parent: int, child: int) -> None:
+    prev = -1
+    c = tree.first_child[parent]
+    while c >= 0 and c != child:
+        prev = c
+        c = tree.next_sibling[c]
+    if prev < 0:
+        tree.first_child[parent] = tree.next_sibling[child]
+    else:
+        tree.next_sibling[prev] = tree.next_sibling[child]
+
+
+@njit(cache=True)
+def _subtree_free_at(tree: Tree, w: World, P: np.ndarray, root: int, delta: float,
+                     counter) -> bool:
+    """Are all edges below ``root`` free when every arrival time moves earlier by delta/v?"""
+    top = 0
+    c = tree.first_child[root]
+    while c >= 0:
+        tree.stack[top] = c
+        top += 1
+        c = tree.next_sibling[c]
+    while top > 0:
+        top -= 1
+        node = tree.stack[top]
+        par = tree.parent[node]
+        t0 = (tree.cost[par] - delta) / P[SPEED]
+        tree.cnt[CHECKS] += 1
+        if not motion_free(w, tree.pose[par, 0], tree.pose[par, 1], tree.pose[par, 2], t0,
+                           tree.kinds[node], tree.lens[node], P[RHO], P[SPEED], counter):
+            return False
+        c = tree.first_child[node]
+        while c >= 0:
+            tree.stack[top] = c
+            top += 1
+            c = tree.next_sibling[c]
+    return True
+
+
+@njit(cache=True)
+def _shift_subtree_cost(tree: Tree, root: int, delta: float) -> None:
+    top = 1
+    tree.stack[0] = root
+    while top > 0:
+        top -= 1
+        node = tree.stack[top]
+        tree.cost[node] -= delta
+        c = tree.first_child[node]
+        while c >= 0:
+            tree.stack[top] = c
+            top += 1
+            c = tree.next_sibling[c]
+
+
+@njit(cache=True)
+def _update_best(tree: Tree) -> None:
+    best = tree.cnt[BEST]
+    for g in range(tree.cnt[NGOAL]):
+        node = tree.goal_nodes[g]
+        if best < 0 or tree.cost[node] < tree.cost[best]:
+            best = node
+    if best >= 0 and tree.cnt[FIRST_ITER] < 0:
+        tree.cnt[FIRST_ITER] = tree.cnt[ITER]
+    tree.cnt[BEST] = best
+
+
+@njit(cache=True)
+def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, kinds, lens,
+                   pk, pl, counter):
+    """Cheapest collision-free parent among the near candidates (branch and bound).
+
+    A candidate j can only win if cost(j) + |j - x_new| < the best cost so far, so most are
+    dismissed without a steering computation; the rest are tried cheapest first until one edge
+    is free. Returns (cost, parent) and leaves the winning edge in kinds/lens.
+    """
+    k = 0
+    for q in range(m):
+        j = tree.near[q]
+        if j == parent or tree.cost[j] + tree.near_len[q] >= c_new - 1e-12:
+            continue
+        bound = min(radius, c_new - tree.cost[j])
+        d = steer_length(P[REVERSE], tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2],
+                         x, y, th, P[RHO], bound)
+        if d < bound:
+            tree.stack[k] = j
+            tree.near_key[k] = tree.cost[j] + d
+            k += 1
+    while k > 0:
+        best = 0
+        for q in range(1, k):
+            if tree.near_key[q] < tree.near_key[best]:
+                best = q
+        j = tree.stack[best]
+        key = tree.near_key[best]
+        k -= 1
+        tree.stack[best] = tree.stack[k]
+        tree.near_key[best] = tree.near_key[k]
+        px, py, pth = tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2]
+        steer_path(P[REVERSE], px, py, pth, x, y, th, P[RHO], pk, pl)
+        tree.cnt[CHECKS] += 1
+        if motion_free(w, px, py, pth, tree.cost[j] / P[SPEED], pk, pl, P[RHO], P[SPEED],
+                       counter):
+            kinds[:] = pk
+            lens[:] = pl
+            return key, j
+    return c_new, parent
+
+
+@njit(cache=True)
+def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> bool:
+    """Run up to ``n_iter`` iterations; returns False when the tree is full (grow and call again).
+
+    Every iteration draws one sample, whether or not it adds a node (as OMPL counts them).
+    """
+    record = ev.rows.shape[0] > 0
+    kinds = np.zeros(5, np.int8)
+    lens = np.zeros(5)
+    cut = np.zeros(5)
+    scratch_k = np.zeros(5, np.int8)
+    scratch_l = np.zeros(5)
+    counter = np.zeros(1, np.int64)
+    timed = w.m_kind.shape[0] > 0
+    for _ in range(n_iter):
+        if tree.cnt[N] >= tree.pose.shape[0]:
+            return False
+        tree.cnt[ITER] += 1
+        xr, yr, thr = _sample(tree, w, P)
+        near_i, dist = nearest(tree, P, xr, yr, thr)
+        nx0, ny0, nth0 = tree.pose[near_i, 0], tree.pose[near_i, 1], tree.pose[near_i, 2]
+        steer_path(P[REVERSE], nx0, ny0, nth0, xr, yr, thr, P[RHO], kinds, lens)
+        if dist > P[EPS]:
+            truncate(kinds, lens, P[EPS], cut)
+            lens[:] = cut
+            dist = P[EPS]
+        x, y, th = path_end(nx0, ny0, nth0, kinds, lens, P[RHO])
+        th = wrap_angle(th)
+        row = -1
+        if record:
+            row = ev.cnt[0]
+            ev.cnt[0] += 1
+            ev.rows[row, :] = -1.0
+            ev.rows[row, EV_ITER] = tree.cnt[ITER]
+            ev.rows[row, EV_XR] = xr
+            ev.rows[row, EV_YR] = yr
+            ev.rows[row, EV_THR] = thr
+            ev.rows[row, EV_NEAREST] = near_i
+        tree.cnt[CHECKS] += 1
+        if dist <= 0.0 or not motion_free(w, nx0, ny0, nth0, tree.cost[near_i] / P[SPEED],
+                                          kinds, lens, P[RHO], P[SPEED], counter):
+            continue
+        parent = near_i
+        c_new = tree.cost[near_i] + dist
+        m = 0
+        radius = 0.0
+        if P[STAR] > 0.0:
+            n = tree.cnt[N] + 1.0
+            radius = min(P[GAMMA] * (math.log(n) / n) ** (1.0 / 3.0), P[EPS])
+            m = _near(tree, x, y, radius)
+            c_new, parent = _choose_parent(tree, w, P, m, x, y, th, radius, c_new, parent,
+                                           kinds, lens, scratch_k, scratch_l, counter)
+        new = add_node(tree, P, x, y, th, c_new, parent, kinds, lens)
+        changed = tree.cnt[NGOAL] > 0 and tree.goal_nodes[tree.cnt[NGOAL] - 1] == new
+        if record:
+            ev.rows[row, EV_NEW] = new
+            ev.rows[row, EV_PARENT] = parent
+            ev.rows[row, EV_RADIUS] = radius
+            ev.rows[row, EV_NEAR_START] = ev.cnt[1]
+            for q in range(m):
+                if ev.cnt[1] < ev.near.shape[0]:
+                    ev.near[ev.cnt[1]] = tree.near[q]
+                    ev.cnt[1] += 1
+            ev.rows[row, EV_NEAR_END] = ev.cnt[1]
+        # Rewire: near nodes that are cheaper to reach through the new node.
+        for q in range(m):
+            j = tree.near[q]
+            if j == parent:
+                continue
+            budget = min(tree.cost[j] - c_new, radius)
+            if tree.near_len[q] >= budget - 1e-9:
+                continue  # even a straight line could not make j cheaper
+            l = steer_length(P[REVERSE], x, y, th, tree.pose[j, 0], tree.pose[j, 1],
+                             tree.pose[j, 2], P[RHO], budget)
+            if l >= budget - 1e-9:
+                continue
+            steer_path(P[REVERSE], x, y, th, tree.pose[j, 0], tree.pose[j, 1],
+                       tree.pose[j, 2], P[RHO], kinds, lens)
+            tree.cnt[CHECKS] += 1
+            if not motion_free(w, x, y, th, c_new / P[SPEED], kinds, lens, P[RHO], P[SPEED],
+                               counter):
+                continue
+            delta = tree.cost[j] - (c_new + l)
+            if timed and not _subtree_free_at(tree, w, P, j, delta, counter):
+                tree.cnt[REFUSED] += 1
+                continue
+            old = tree.parent[j]
+            _unlink_child(tree, old, j)
+            tree.parent[j] = new
+            tree.next_sibling[j] = tree.first_child[new]
+            tree.first_child[new] = j
+            tree.kinds[j, :] = kinds
+            tree.lens[j, :] = lens
+            _shift_subtree_cost(tree, j, delta)
+            tree.cnt[REWIRES] += 1
+            changed = True
+            if record and ev.cnt[2] < ev.rewires.shape[0]:
+                r = ev.cnt[2]
+                ev.rewires[r, 0] = tree.cnt[ITER]
+                ev.rewires[r, 1] = j
+                ev.rewires[r, 2] = old
+                ev.rewires[r, 3] = new
+                ev.cnt[2] += 1
+        if changed:
+            _update_best(tree)
+        if record:
+            ev.rows[row, EV_BEST] = tree.cost[tree.cnt[BEST]] if tree.cnt[BEST] >= 0 else math.inf
+    tree.cnt[EVALS] += counter[0]
+    return True

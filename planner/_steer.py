@@ -1,0 +1,19 @@
+"""Steering dispatch: Dubins (forward only) or Reeds-Shepp (forward and reverse)."""
+
+from __future__ import annotations
+
+from numba import njit
+
+from planner._dubins import dubins_length, dubins_path
+
+
+@njit(cache=True, inline="always")
+def steer_path(reverse, x0, y0, th0, x1, y1, th1, rho, kinds, lens) -> float:
+    """Shortest local path between two poses, written into kinds/lens; returns its length."""
+    return dubins_path(x0, y0, th0, x1, y1, th1, rho, kinds, lens)
+
+
+@njit(cache=True, inline="always")
+def steer_length(reverse, x0, y0, th0, x1, y1, th1, rho, bound) -> float:
+    """Length of the shortest local path (may exceed ``bound`` early when longer than it)."""
+    return dubins_length(x0, y0, th0, x1, y1, th1, rho, bound)

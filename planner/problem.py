@@ -1,0 +1,109 @@
+"""A planning problem: a validated scenario compiled into a `World` plus start, goal and car.
+
+This is the one place that turns scenario objects (circles, boxes, polygons, motions, a track)
+into the arrays the kernels read, and that rejects problems no planner can solve (start or goal
+in collision or outside the region).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from planner._world import World, build_world, clearance
+from planner.scenario import Box, Circle, Scenario, ScenarioError
+
+__all__ = ["Problem", "compile_problem"]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """What a planner needs, in SI units. ``timed``: some obstacle moves."""
+
+    scenario: Scenario
+    world: World
+    start: tuple[float, float, float]
+    goal: tuple[float, float, float]
+    goal_position_tol: float
+    goal_heading_tol: float  # radians
+    rho: float
+    speed: float
+    timed: bool
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        return tuple(float(v) for v in self.world.geo[:4])
+
+    def clearance(self, x: float, y: float, t: float = 0.0) -> float:
+        """Signed clearance of the car's disc at (x, y) at time t (NaN: static obstacles only)."""
+        return float(clearance(self.world, x, y, t))
+
+
+def _track_region(scenario: Scenario):
+    import tracks  # imported lazily: a track is optional, and tracks needs svg libraries
+
+    try:
+        track = tracks.load_library_track(scenario.track.name)
+    except (KeyError, ValueError) as exc:
+        raise ScenarioError(f"track: {exc}") from None
+    if scenario.track.width_m is not None:
+        track = track.with_width(scenario.track.width_m)
+    return track
+
+
+def _follow_waypoints(track, follow, step_s: float = 0.05) -> np.ndarray:
+    """A track-following motion as dense timed offsets from its position at t = 0."""
+    prof = track.sample(spacing=0.02)
+    times = np.arange(0.0, follow.horizon_s + step_s, step_s)
+    s = follow.start_s + follow.speed * times
+    s = np.mod(s, prof.s[-1]) if track.closed else np.clip(s, 0.0, prof.s[-1])
+    x = np.interp(s, prof.s, prof.x)
+    y = np.interp(s, prof.s, prof.y)
+    return np.column_stack([times, x - x[0], y - y[0]])
+
+
+def compile_problem(scenario: Scenario) -> Problem:
+    """Compile and sanity-check a scenario; raises ScenarioError for unplannable input."""
+    track = _track_region(scenario) if scenario.track is not None else None
+    rings = track.region_rings() if track is not None else []
+    if scenario.bounds is not None:
+        bounds = scenario.bounds
+    else:
+        pts = np.vstack(rings)
+        margin = 0.01
+        bounds = (*(pts.min(axis=0) - margin), *(pts.max(axis=0) + margin))
+    motions, circles, polygons = [], [], []
+    for ob in scenario.obstacles:
+        m = -1
+        if ob.motion is not None:
+            m = len(motions)
+            if ob.motion.velocity is not None:
+                motions.append(("velocity", ob.motion.velocity))
+            elif ob.motion.waypoints is not None:
+                motions.append(("waypoints", ob.motion.waypoints))
+            else:
+                motions.append(("waypoints", _follow_waypoints(track, ob.motion.follow_track)))
+        if isinstance(ob, Circle):
+            circles.append((*ob.center, ob.radius, m))
+        elif isinstance(ob, Box):
+            polygons.append((ob.corners(), m))
+        else:
+            polygons.append((ob.points, m))
+    world = build_world(bounds, scenario.vehicle.radius, circles, polygons, motions, rings)
+    tol = scenario.goal_tolerance
+    problem = Problem(
+        scenario=scenario, world=world, start=tuple(scenario.start), goal=tuple(scenario.goal),
+        goal_position_tol=tol.position, goal_heading_tol=math.radians(tol.heading_deg),
+        rho=scenario.vehicle.turning_radius, speed=scenario.vehicle.speed,
+        timed=scenario.has_motion)
+    sx, sy, _ = problem.start
+    if problem.clearance(sx, sy, 0.0) <= 0.0:
+        raise ScenarioError(f"start {list(problem.start)} is in collision or outside the region "
+                            f"at t = 0 (clearance {problem.clearance(sx, sy, 0.0):.3f} m)")
+    gx, gy, _ = problem.goal
+    if problem.clearance(gx, gy, math.nan) <= 0.0:
+        raise ScenarioError(f"goal {list(problem.goal)} is in collision or outside the region "
+                            f"(clearance {problem.clearance(gx, gy, math.nan):.3f} m)")
+    return problem

@@ -1,0 +1,327 @@
+"""RRT and RRT* for a car: a `Planner` with step() and solve(), over the compiled kernel.
+
+The planner object owns the tree arrays and the random state, so a run is reproducible from its
+seed, can be advanced one iteration at a time (the studio's step mode) or for a time budget, and
+can be observed through listeners that receive the kernel's event records.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from planner import _kernel as K
+from planner._paths import sample_path
+from planner._rng import seed_state
+from planner._world import path_clearances
+from planner.problem import Problem
+
+__all__ = ["Planner", "PlannerSettings", "Result", "TreeEvents", "TreeSnapshot", "solve"]
+
+ALGORITHMS = ("rrt", "rrtstar")
+STEERINGS = ("dubins", "reeds-shepp")
+
+
+@dataclass(frozen=True)
+class PlannerSettings:
+    """Every knob of a run. ``None`` means "derive from the problem" (see `resolved`)."""
+
+    algorithm: str = "rrtstar"
+    steering: str = "dubins"
+    eps: float | None = None  # longest extension (m)
+    gamma: float | None = None  # RRT* radius constant
+    goal_bias: float = 0.05
+    informed: bool | None = None  # default: on for RRT*
+    seed: int = 0
+    speed: float | None = None  # planning speed v (m/s): default the vehicle's
+
+    def __post_init__(self) -> None:
+        if self.algorithm not in ALGORITHMS:
+            raise ValueError(f"unknown planner '{self.algorithm}' (use one of {ALGORITHMS})")
+        if self.steering not in STEERINGS:
+            raise ValueError(f"unknown steering '{self.steering}' (use one of {STEERINGS})")
+        for name in ("eps", "gamma", "speed"):
+            v = getattr(self, name)
+            if v is not None and not (math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be a finite number > 0, got {v}")
+        if not 0.0 <= self.goal_bias < 1.0:
+            raise ValueError(f"goal_bias must be in [0, 1), got {self.goal_bias}")
+
+    def resolved(self, problem: Problem) -> PlannerSettings:
+        """Fill the derived defaults: ε from the workspace size, γ as OMPL's RRT* does."""
+        xmin, ymin, xmax, ymax = problem.bounds
+        diag = math.hypot(xmax - xmin, ymax - ymin)
+        eps = self.eps if self.eps is not None else max(0.1 * diag, 2.0 * problem.rho)
+        if self.gamma is not None:
+            gamma = self.gamma
+        else:
+            # γ > γ* = (2 (1 + 1/d) μ(X) / ζ_d)^(1/d) with d = 3, μ = area · 2π, ζ_3 = 4π/3.
+            measure = (xmax - xmin) * (ymax - ymin) * 2.0 * math.pi
+            gamma = 1.1 * (2.0 * (4.0 / 3.0) * measure / (4.0 * math.pi / 3.0)) ** (1.0 / 3.0)
+        informed = self.informed if self.informed is not None else self.algorithm == "rrtstar"
+        speed = self.speed if self.speed is not None else problem.speed
+        return PlannerSettings(self.algorithm, self.steering, eps, gamma, self.goal_bias,
+                               informed, self.seed, speed)
+
+
+@dataclass
+class Result:
+    """The outcome of a run: the best path as dense samples, and the metrics."""
+
+    solved: bool
+    cost: float | None
+    time_to_first_solution_s: float | None
+    iterations: int
+    nodes: int
+    collision_checks: int
+    clearance_evaluations: int
+    rewires: int
+    refused_rewires: int
+    planning_time_s: float
+    min_clearance_m: float | None
+    max_abs_curvature: float | None
+    cost_over_time: list[tuple[float, float]]
+    path: np.ndarray  # (n, 6): x, y, theta, curvature, direction, t
+    timed: bool
+    settings: PlannerSettings
+
+    def cost_at(self, t: float) -> float | None:
+        """Best cost found within the first ``t`` seconds, or None."""
+        best = None
+        for when, cost in self.cost_over_time:
+            if when <= t:
+                best = cost
+        return best
+
+
+@dataclass(frozen=True)
+class TreeSnapshot:
+    """A copy of the tree for viewers: they never read the planner's live arrays."""
+
+    pose: np.ndarray
+    parent: np.ndarray
+    cost: np.ndarray
+    best_node: int
+
+
+@dataclass(frozen=True)
+class TreeEvents:
+    """What happened in a batch of iterations (see `_kernel` for the row columns)."""
+
+    rows: np.ndarray
+    near: np.ndarray
+    rewires: np.ndarray
+
+
+@dataclass
+class _Clock:
+    started: float = field(default_factory=time.perf_counter)
+    first_solution_s: float | None = None
+    cost_over_time: list[tuple[float, float]] = field(default_factory=list)
+
+    def elapsed(self) -> float:
+        return time.perf_counter() - self.started
+
+
+class Planner:
+    """An RRT / RRT* run on one problem. Not thread-safe: drive it from one thread."""
+
+    def __init__(self, problem: Problem, settings: PlannerSettings | None = None,
+                 capacity: int = 4096) -> None:
+        self.problem = problem
+        self.settings = (settings or PlannerSettings()).resolved(problem)
+        s = self.settings
+        xmin, ymin, xmax, ymax = problem.bounds
+        diag = math.hypot(xmax - xmin, ymax - ymin)
+        cell = min(max(s.eps / 4.0, diag / 400.0), diag / 8.0)
+        nx, ny = math.ceil((xmax - xmin) / cell), math.ceil((ymax - ymin) / cell)
+        grid = np.array([xmin, ymin, cell, nx, ny], dtype=float)
+        self._tree = K.new_tree(capacity, grid, seed_state(s.seed))
+        self._tree.cnt[K.BEST] = -1
+        self._tree.cnt[K.FIRST_ITER] = -1
+        P = np.zeros(K.NPARAMS)
+        P[K.EPS], P[K.GAMMA], P[K.GOAL_BIAS] = s.eps, s.gamma, s.goal_bias
+        P[K.RHO], P[K.SPEED] = problem.rho, s.speed
+        P[K.GX], P[K.GY], P[K.GTH] = problem.goal
+        P[K.GPOS], P[K.GHEAD] = problem.goal_position_tol, problem.goal_heading_tol
+        P[K.INFORMED] = float(s.informed)
+        P[K.STAR] = float(s.algorithm == "rrtstar")
+        P[K.REVERSE] = float(s.steering == "reeds-shepp")
+        P[K.SX], P[K.SY] = problem.start[:2]
+        self._P = P
+        zero = np.zeros(5)
+        K.add_node(self._tree, P, *problem.start, 0.0, -1, zero.astype(np.int8), zero)
+        self._no_events = K.Events(np.zeros((0, K.EV_COLS)), np.zeros(0, np.int64),
+                                   np.zeros((0, 4), np.int64), np.zeros(3, np.int64))
+        self._listeners: list[Callable[[TreeEvents], None]] = []
+        self._clock = _Clock()
+        self._best_cost = math.inf
+        self._compute_time = 0.0
+
+    # -- observation -------------------------------------------------------------------------
+    def add_listener(self, listener: Callable[[TreeEvents], None]) -> None:
+        """Receive a `TreeEvents` after every batch of iterations (costs nothing when absent)."""
+        self._listeners.append(listener)
+
+    @property
+    def iterations(self) -> int:
+        return int(self._tree.cnt[K.ITER])
+
+    @property
+    def nodes(self) -> int:
+        return int(self._tree.cnt[K.N])
+
+    @property
+    def solved(self) -> bool:
+        return bool(self._tree.cnt[K.BEST] >= 0)
+
+    @property
+    def best_cost(self) -> float | None:
+        best = self._tree.cnt[K.BEST]
+        return float(self._tree.cost[best]) if best >= 0 else None
+
+    def snapshot(self) -> TreeSnapshot:
+        n = self.nodes
+        t = self._tree
+        return TreeSnapshot(t.pose[:n].copy(), t.parent[:n].copy(), t.cost[:n].copy(),
+                            int(t.cnt[K.BEST]))
+
+    # -- running -----------------------------------------------------------------------------
+    def step(self, iterations: int = 1) -> None:
+        """Advance by ``iterations`` samples (grows the tree arrays as needed)."""
+        events = self._event_buffers(iterations) if self._listeners else self._no_events
+        done_before = self.iterations
+        target = done_before + iterations
+        t0 = time.perf_counter()
+        while self.iterations < target:
+            if not K.iterate(self._tree, self.problem.world, self._P,
+                             target - self.iterations, events):
+                self._tree = K.grown(self._tree, 2 * self._tree.pose.shape[0])
+        self._compute_time += time.perf_counter() - t0
+        self._note_progress(done_before)
+        if self._listeners:
+            n_rows, n_near, n_rw = events.cnt
+            batch = TreeEvents(events.rows[:n_rows].copy(), events.near[:n_near].copy(),
+                               events.rewires[:n_rw].copy())
+            for listener in self._listeners:
+                listener(batch)
+
+    def _event_buffers(self, iterations: int) -> K.Events:
+        near_cap = max(64, 64 * iterations)
+        return K.Events(np.zeros((iterations, K.EV_COLS)), np.zeros(near_cap, np.int64),
+                        np.zeros((max(64, 16 * iterations), 4), np.int64),
+                        np.zeros(3, np.int64))
+
+    def _note_progress(self, iterations_before: int) -> None:
+        cost = self.best_cost
+        if cost is None or cost >= self._best_cost:
+            return
+        now = self._compute_time
+        if self._clock.first_solution_s is None:
+            # Interpolate inside the batch: the kernel knows the iteration of the first solution.
+            self._clock.first_solution_s = now
+        self._best_cost = cost
+        self._clock.cost_over_time.append((now, cost))
+
+    def solve(self, time_limit: float | None = 1.0, iterations: int | None = None) -> Result:
+        """Run until the time or iteration budget is spent (RRT: until the first solution)."""
+        if time_limit is None and iterations is None:
+            raise ValueError("give a time limit, an iteration budget, or both")
+        warm_up()
+        batch = 16
+        limit = math.inf if time_limit is None else time_limit
+        max_iter = math.inf if iterations is None else self.iterations + iterations
+        start = self._compute_time
+        while self._compute_time - start < limit and self.iterations < max_iter:
+            n = int(min(batch, max_iter - self.iterations))
+            t0 = time.perf_counter()
+            self.step(n)
+            took = time.perf_counter() - t0
+            if self.settings.algorithm == "rrt" and self.solved:
+                break
+            # Aim at ~2 ms batches: fine-grained budgets and cost-over-time samples.
+            batch = max(1, min(4096, int(batch * (0.002 / took if took > 0 else 2.0))))
+        return self.result()
+
+    # -- results -----------------------------------------------------------------------------
+    def best_path_nodes(self) -> list[int]:
+        node = int(self._tree.cnt[K.BEST])
+        chain = []
+        while node >= 0:
+            chain.append(node)
+            node = int(self._tree.parent[node])
+        return chain[::-1]
+
+    def dense_path(self, spacing: float = 0.05) -> np.ndarray:
+        """The best path sampled every ≤ spacing m: columns x, y, θ, κ, direction, t."""
+        t = self._tree
+        chain = self.best_path_nodes()
+        if not chain:
+            return np.zeros((0, 6))
+        parts = [np.array([[*t.pose[chain[0]], 0.0, 1.0]])]
+        for node in chain[1:]:
+            par = t.parent[node]
+            seg = sample_path(*t.pose[par], t.kinds[node], t.lens[node], self.problem.rho,
+                              spacing)
+            parts.append(seg[1:])
+        pts = np.vstack(parts)
+        driven = np.concatenate([[0.0], np.cumsum(_step_lengths(pts))])
+        return np.column_stack([pts, driven / self.settings.speed])
+
+    def result(self) -> Result:
+        t = self._tree
+        path = self.dense_path(0.05)
+        fine = self.dense_path(0.005)
+        solved = self.solved
+        min_clear = (float(path_clearances(self.problem.world, fine, self.problem.timed).min())
+                     if solved else None)
+        return Result(
+            solved=solved, cost=self.best_cost,
+            time_to_first_solution_s=self._clock.first_solution_s,
+            iterations=self.iterations, nodes=self.nodes,
+            collision_checks=int(t.cnt[K.CHECKS]), clearance_evaluations=int(t.cnt[K.EVALS]),
+            rewires=int(t.cnt[K.REWIRES]), refused_rewires=int(t.cnt[K.REFUSED]),
+            planning_time_s=self._compute_time, min_clearance_m=min_clear,
+            max_abs_curvature=float(np.abs(path[:, 3]).max()) if solved else None,
+            cost_over_time=list(self._clock.cost_over_time), path=path,
+            timed=self.problem.timed, settings=self.settings)
+
+
+def _step_lengths(pts: np.ndarray) -> np.ndarray:
+    """Driven length between consecutive samples (arc, not chord): |Δθ|·ρ on arcs."""
+    chord = np.hypot(*np.diff(pts[:, :2], axis=0).T)
+    dth = np.abs(np.diff(np.unwrap(pts[:, 2])))
+    kappa = np.abs(pts[1:, 3])
+    arc = np.where(kappa > 0, dth / np.where(kappa > 0, kappa, 1.0), chord)
+    return np.maximum(arc, chord)
+
+
+_warm = False
+
+
+def warm_up() -> None:
+    """Compile (or load from numba's cache) the kernels once, outside any timed budget."""
+    global _warm
+    if _warm:
+        return
+    from planner._world import build_world
+
+    world = build_world((0, 0, 10, 10), 0.1, [(5, 5, 1, -1)], [([(1, 1), (2, 1), (2, 2)], 0)],
+                        [("velocity", (0.1, 0))])
+    problem = Problem(None, world, (0.5, 0.5, 0.0), (9, 9, 0.0), 0.5, 0.5, 1.0, 1.0, True)
+    for algorithm in ALGORITHMS:
+        for steering in STEERINGS:
+            p = Planner(problem, PlannerSettings(algorithm=algorithm, steering=steering))
+            p.step(40)
+            p.result()
+    _warm = True
+
+
+def solve(problem: Problem, *, time_limit: float | None = 1.0, iterations: int | None = None,
+          **settings) -> Result:
+    """Plan once: ``solve(problem, algorithm="rrtstar", steering="dubins", seed=0, …)``."""
+    return Planner(problem, PlannerSettings(**settings)).solve(time_limit, iterations)

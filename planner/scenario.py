@@ -1,0 +1,242 @@
+"""Scenarios: the shared minimal format (FORMAT.md v1–v1.2) and Trackstar's richer schema.
+
+One pydantic model reads both, because the rich schema is a superset: a scenario may name a
+library track as its drivable region (then ``bounds`` may be omitted), use oriented boxes, and
+let obstacles follow a track. Every object rejects unknown keys and suggests the nearest valid
+one, so a typo fails loudly instead of silently meaning a default.
+"""
+
+from __future__ import annotations
+
+import difflib
+import json
+import math
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+__all__ = ["ScenarioError", "Scenario", "load_scenario", "parse_scenario", "scenario_schema"]
+
+
+class ScenarioError(ValueError):
+    """A scenario that cannot be planned, with a one-line message naming the field."""
+
+
+def _suggest(key: str, valid: list[str]) -> str:
+    close = difflib.get_close_matches(key, valid, n=1, cutoff=0.5)
+    return f" (did you mean '{close[0]}'?)" if close else f" (valid keys: {', '.join(valid)})"
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _known_keys(cls, data: Any) -> Any:
+        if isinstance(data, dict):
+            valid = sorted(cls.model_fields)
+            for key in data:
+                if key not in cls.model_fields:
+                    raise ValueError(f"unknown key '{key}'{_suggest(str(key), valid)}")
+        return data
+
+
+Pose = tuple[float, float, float]
+Point = tuple[float, float]
+Positive = Annotated[float, Field(gt=0)]
+
+
+class Vehicle(_Strict):
+    """The car: geometry for planning (v1), speed (v1.1) and limits for simulation (v1.2)."""
+
+    wheelbase: Positive = 0.44
+    max_steer_deg: Annotated[float, Field(gt=0, lt=90)] = 26.0
+    min_turning_radius: Positive | None = None
+    radius: Annotated[float, Field(ge=0)] = 0.0
+    speed: Positive = 1.0
+    max_speed: Positive | None = None
+    max_accel: Positive = 1.0
+    max_steer_rate_deg_s: Positive = 180.0
+
+    @model_validator(mode="after")
+    def _speeds(self) -> Vehicle:
+        if self.max_speed is not None and self.max_speed < self.speed:
+            raise ValueError(f"max_speed ({self.max_speed}) is below speed ({self.speed})")
+        return self
+
+    @property
+    def turning_radius(self) -> float:
+        """ρ = L / tan δmax unless given explicitly."""
+        if self.min_turning_radius is not None:
+            return self.min_turning_radius
+        return self.wheelbase / math.tan(math.radians(self.max_steer_deg))
+
+
+class GoalTolerance(_Strict):
+    position: Annotated[float, Field(gt=0)] = 0.25
+    heading_deg: Annotated[float, Field(gt=0, le=180)] = 20.0
+
+
+class Motion(_Strict):
+    """Exactly one of: constant velocity, timed waypoints, or following a library track."""
+
+    velocity: Point | None = None
+    waypoints: list[tuple[float, float, float]] | None = None
+    follow_track: FollowTrack | None = None
+
+    @model_validator(mode="after")
+    def _exactly_one(self) -> Motion:
+        given = [k for k in ("velocity", "waypoints", "follow_track") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError("give exactly one of 'velocity' and 'waypoints' "
+                             f"(or 'follow_track'), got {given or 'none'}")
+        if self.waypoints is not None:
+            if not self.waypoints:
+                raise ValueError("'waypoints' is empty: give at least one [t, dx, dy]")
+            times = [w[0] for w in self.waypoints]
+            if any(b <= a for a, b in zip(times, times[1:])):
+                raise ValueError(f"waypoint times must be strictly increasing, got {times}")
+        return self
+
+
+class FollowTrack(_Strict):
+    """Drive along the scenario's track centreline at ``speed`` from arc length ``start_s``."""
+
+    speed: float
+    start_s: float = 0.0
+    horizon_s: Positive = 120.0
+
+
+class Circle(_Strict):
+    type: Literal["circle"]
+    center: Point
+    radius: Positive
+    motion: Motion | None = None
+
+
+class Polygon(_Strict):
+    type: Literal["polygon"]
+    points: Annotated[list[Point], Field(min_length=3)]
+    motion: Motion | None = None
+
+
+class Box(_Strict):
+    """An oriented rectangle (rich schema): centre, size (length, width), heading in degrees."""
+
+    type: Literal["box"]
+    center: Point
+    size: tuple[Positive, Positive]
+    angle_deg: float = 0.0
+    motion: Motion | None = None
+
+    def corners(self) -> list[Point]:
+        c, s = math.cos(math.radians(self.angle_deg)), math.sin(math.radians(self.angle_deg))
+        hx, hy = self.size[0] / 2, self.size[1] / 2
+        return [(self.center[0] + c * u - s * v, self.center[1] + s * u + c * v)
+                for u, v in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))]
+
+
+Obstacle = Annotated[Circle | Polygon | Box, Field(discriminator="type")]
+
+
+class TrackRef(_Strict):
+    """A library track as the drivable region (rich schema)."""
+
+    name: str
+    width_m: Positive | None = None
+
+
+class Scenario(_Strict):
+    """A planning problem. Units: metres and radians, except the ``*_deg`` fields."""
+
+    name: str
+    description: str = ""
+    bounds: tuple[float, float, float, float] | None = None
+    track: TrackRef | None = None
+    vehicle: Vehicle = Vehicle()
+    start: Pose
+    goal: Pose
+    goal_tolerance: GoalTolerance = GoalTolerance()
+    obstacles: list[Obstacle] = []
+
+    @model_validator(mode="after")
+    def _region(self) -> Scenario:
+        if self.bounds is None and self.track is None:
+            raise ValueError("give 'bounds' (or a 'track' as the drivable region)")
+        if self.bounds is not None:
+            xmin, ymin, xmax, ymax = self.bounds
+            if not (xmin < xmax and ymin < ymax):
+                raise ValueError(f"bounds must be [xmin, ymin, xmax, ymax] with min < max, "
+                                 f"got {list(self.bounds)}")
+        for i, ob in enumerate(self.obstacles):
+            if ob.motion and ob.motion.follow_track and self.track is None:
+                raise ValueError(f"obstacles[{i}].motion.follow_track needs a 'track'")
+        return self
+
+    @property
+    def has_motion(self) -> bool:
+        """True when any obstacle moves: then plans are timed ([x, y, θ, t])."""
+        return any(ob.motion is not None for ob in self.obstacles)
+
+
+def _location(loc: tuple) -> str:
+    """('obstacles', 2, 'circle', 'radius') → 'obstacles[2].radius' (drops union tags)."""
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif part in ("circle", "polygon", "box") or part.startswith("function-"):
+            continue
+        else:
+            out += f".{part}" if out else str(part)
+    return out
+
+
+def _describe(exc: ValidationError) -> str:
+    err = exc.errors()[0]
+    where = _location(err["loc"])
+    msg = err["msg"].removeprefix("Value error, ")
+    if err["type"] == "union_tag_invalid":
+        tag = str(err.get("input", {}).get("type", ""))
+        msg = f"unknown obstacle type '{tag}'{_suggest(tag, ['box', 'circle', 'polygon'])}"
+    elif err["type"] == "union_tag_not_found":
+        msg = "obstacle without 'type' (circle, polygon or box)"
+    elif err["type"] == "finite_number":
+        msg = "must be a finite number (NaN and infinity are not allowed)"
+    return f"{where}: {msg}" if where else msg
+
+
+def parse_scenario(data: Any) -> Scenario:
+    """Validate a decoded JSON object; raises ScenarioError with a one-line message."""
+    if not isinstance(data, dict):
+        raise ScenarioError(f"a scenario is a JSON object, got {type(data).__name__}")
+    try:
+        return Scenario.model_validate(data)
+    except ValidationError as exc:
+        raise ScenarioError(f"invalid scenario: {_describe(exc)}") from None
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario file (minimal FORMAT.md or the rich schema)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ScenarioError(f"no such scenario file: {path}") from None
+    except (IsADirectoryError, UnicodeDecodeError) as exc:
+        raise ScenarioError(f"cannot read scenario {path}: {exc}") from None
+    try:
+        data = json.loads(text, parse_constant=_reject_constant)
+    except json.JSONDecodeError as exc:
+        raise ScenarioError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    return parse_scenario(data)
+
+
+def _reject_constant(name: str) -> float:
+    raise ScenarioError(f"{name} is not allowed in a scenario: numbers must be finite")
+
+
+def scenario_schema() -> dict:
+    """The JSON Schema of the rich scenario format."""
+    return Scenario.model_json_schema()
