@@ -1,7 +1,104 @@
-"""`trackstar plan` — placeholder until the planner core lands."""
+"""`trackstar plan` and `trackstar scenario …`: plan a scenario file, print or check schemas."""
+
+from __future__ import annotations
+
+import json
+from enum import Enum
+from pathlib import Path
+from typing import Annotated
 
 import typer
+
+from app.cli._errors import user_errors
+
+
+class Algorithm(str, Enum):
+    rrt = "rrt"
+    rrtstar = "rrtstar"
+
+
+class Steering(str, Enum):
+    dubins = "dubins"
+    reeds_shepp = "reeds-shepp"
+
+
+scenario_cli = typer.Typer(help="Scenario files: schema and validation.", no_args_is_help=True)
+
+
+def plan(
+    scenario: Annotated[Path, typer.Argument(help="Scenario JSON (FORMAT.md or the rich schema).")],
+    planner: Annotated[Algorithm, typer.Option(help="Planning algorithm.")] = Algorithm.rrtstar,
+    steering: Annotated[Steering, typer.Option(help="Car steering.")] = Steering.dubins,
+    time: Annotated[float | None, typer.Option(help="Time budget in seconds [default: 1.0, "
+                                                    "or none when --iterations is given].")] = None,
+    iterations: Annotated[int | None, typer.Option(min=1, help="Iteration budget.")] = None,
+    seed: Annotated[int, typer.Option(help="Random seed: same seed, same tree.")] = 0,
+    eps: Annotated[float | None, typer.Option(help="Longest extension ε (m).")] = None,
+    gamma: Annotated[float | None, typer.Option(help="RRT* radius constant γ.")] = None,
+    goal_bias: Annotated[float, typer.Option(help="Probability of sampling the goal.")] = 0.05,
+    informed: Annotated[bool | None, typer.Option(help="Informed sampling after the first "
+                                                       "solution [default: on for RRT*].")] = None,
+    speed: Annotated[float | None, typer.Option(help="Planning speed v (m/s) [default: the "
+                                                     "scenario's vehicle.speed].")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Plan a path for the car from start to goal with RRT or RRT*."""
+    import planner as core
+    from planner.report import plan_report
+
+    with user_errors():
+        if time is not None and not time > 0:
+            raise ValueError(f"--time must be > 0, got {time}")
+        budget_time = 1.0 if time is None and iterations is None else time
+        problem = core.compile_problem(core.load_scenario(scenario))
+        settings = core.PlannerSettings(
+            algorithm=planner.value, steering=steering.value, eps=eps, gamma=gamma,
+            goal_bias=goal_bias, informed=informed, seed=seed, speed=speed)
+        result = core.Planner(problem, settings).solve(budget_time, iterations)
+    report = plan_report(result, problem.scenario.name,
+                         {"time": budget_time, "iterations": iterations})
+    if as_json:
+        typer.echo(report.model_dump_json())
+        return
+    _print_summary(report)
+
+
+def _print_summary(report) -> None:
+    p = report.parameters
+    typer.echo(f"{report.scenario}: {p['algorithm']} with {p['steering']} steering, seed {p['seed']}")
+    if not report.solved:
+        typer.echo(f"  not solved within the budget ({report.iterations} iterations, "
+                   f"{report.nodes} nodes)")
+        return
+    typer.echo(f"  cost {report.cost:.3f} m, first solution after "
+               f"{1000 * report.time_to_first_solution_s:.1f} ms")
+    typer.echo(f"  {report.iterations} iterations, {report.nodes} nodes, "
+               f"{report.collision_checks} motion checks, {report.rewires} rewires")
+    typer.echo(f"  min clearance {report.min_clearance_m:.3f} m, "
+               f"max |curvature| {report.max_abs_curvature:.3f} 1/m")
+    if report.arrival_time_s is not None:
+        typer.echo(f"  arrives at t = {report.arrival_time_s:.2f} s")
+
+
+@scenario_cli.command("schema")
+def schema() -> None:
+    """Print the JSON Schema of the rich scenario format."""
+    from planner import scenario_schema
+
+    typer.echo(json.dumps(scenario_schema(), indent=2))
+
+
+@scenario_cli.command("check")
+def check(scenario: Annotated[Path, typer.Argument(help="Scenario JSON file.")]) -> None:
+    """Validate a scenario (schema, start and goal free); exit 2 with one line if it is not."""
+    import planner as core
+
+    with user_errors():
+        problem = core.compile_problem(core.load_scenario(scenario))
+    typer.echo(f"{problem.scenario.name}: ok")
 
 
 def register(cli: typer.Typer) -> None:
     """Add the planning commands to the main CLI."""
+    cli.command("plan")(plan)
+    cli.add_typer(scenario_cli, name="scenario")

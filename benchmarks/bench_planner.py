@@ -1,0 +1,256 @@
+"""Planner benchmark: Trackstar's RRT* against OMPL's RRT*, Informed RRT* and BIT*, Dubins steering.
+
+    python benchmarks/bench_planner.py        # 5 static scenarios, budgets 0.1 s and 1 s, seeds 0-4
+
+Each OMPL run is a fresh process (OMPL's seed is process-wide), one per budget. Ours runs in this
+process after one untimed warm-up solve per scenario (compilation is not what we measure), once per
+seed at the largest budget: its iterations do not depend on the budget, so its cost at a smaller
+budget is read from cost_over_time. Runs are sequential, never two at once, so timings are fair.
+Prints the table and writes it to benchmarks/results/planner.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from datetime import date
+from pathlib import Path
+
+from tqdm import tqdm
+
+SCENARIO_DIR = Path("/work/shared/scenarios")
+STATIC_SCENARIOS = ["open_field", "hallway", "slalom", "parking", "oval_track"]
+OMPL_PLANNERS = ["RRTstar", "InformedRRTstar", "BITstar"]
+OURS = "ours"
+RESULTS_MD = Path(__file__).resolve().parent / "results" / "planner.md"
+
+
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenarios", nargs="+", default=STATIC_SCENARIOS, metavar="NAME",
+                        help="scenario names (crossing has a moving obstacle OMPL cannot express)")
+    parser.add_argument("--scenario-dir", type=Path, default=SCENARIO_DIR)
+    parser.add_argument("--seeds", nargs="+", type=int, default=list(range(5)))
+    parser.add_argument("--budgets", nargs="+", type=float, default=[0.1, 1.0], metavar="SECONDS")
+    parser.add_argument("--only", choices=[OURS, "ompl"], help="run only our planner or only OMPL")
+    parser.add_argument("--json", type=Path, metavar="OUT", help="also write every run's record")
+    args = parser.parse_args(argv)
+    args.budgets = sorted(args.budgets)
+    return args
+
+
+def ompl_runs(scenarios: dict[str, dict], seeds: list[int], budgets: list[float],
+              bar: tqdm) -> list[dict]:
+    """One fresh-process OMPL run per (scenario, planner, budget, seed)."""
+    from ompl_baseline import run_ompl_isolated  # imports OMPL: only when OMPL is benchmarked
+
+    records = []
+    for scenario in scenarios.values():
+        for name in OMPL_PLANNERS:
+            for budget in budgets:
+                for seed in seeds:
+                    bar.set_postfix_str(f"{scenario['name']} {name} {budget:g}s seed {seed}")
+                    records.append(run_ompl_isolated(scenario, name, budget, seed))
+                    bar.update()
+    return records
+
+
+def _our_planner():
+    """The `planner` package, or exit with a hint while its solve() does not exist yet."""
+    import planner
+
+    if not hasattr(planner, "solve"):
+        raise SystemExit("planner.solve is not available yet: run with --only ompl")
+    return planner
+
+
+def our_runs(trackstar, paths: dict[str, Path], seeds: list[int], budgets: list[float],
+             bar: tqdm) -> list[dict]:
+    """One run of ours per (scenario, seed) at the largest budget, reported at every budget."""
+    records = []
+    for name, path in paths.items():
+        scenario = trackstar.load_scenario(path)
+        trackstar.solve(scenario, planner="rrtstar", steering="dubins", time_limit=0.05, seed=0)
+        for seed in seeds:
+            bar.set_postfix_str(f"{name} ours seed {seed}")
+            start = time.perf_counter()
+            result = trackstar.solve(scenario, planner="rrtstar", steering="dubins",
+                                     time_limit=budgets[-1], seed=seed)
+            setup_s = time.perf_counter() - start - result.planning_time_s
+            records += [_our_record(result, name, seed, budget, setup_s) for budget in budgets]
+            bar.update()
+    return records
+
+
+def _our_record(result, scenario: str, seed: int, budget: float, setup_s: float) -> dict:
+    """Our result as it stood at `budget`, in the record format of ompl_baseline.run_ompl.
+
+    Iterations per second of planning, as for OMPL, whose problem set-up is not timed either;
+    the set-up time of ours (solve()'s wall time outside planning) is kept as `setup_s`.
+    """
+    costs = [cost for t, cost in result.cost_over_time if t <= budget]
+    return {
+        "scenario": scenario,
+        "planner": OURS,
+        "time_limit_s": budget,
+        "seed": seed,
+        "solved": bool(costs),
+        "cost": min(costs) if costs else None,
+        "time_to_first_solution_s": result.time_to_first_solution_s,
+        "iterations": result.iterations,
+        "iterations_per_s": result.iterations / result.planning_time_s,
+        "nodes": result.nodes,
+        "valid_5mm": None,
+        "setup_s": setup_s,
+    }
+
+
+def _median(values: list) -> float | None:
+    values = [v for v in values if v is not None]
+    return statistics.median(values) if values else None
+
+
+def summarise(records: list[dict], budgets: list[float]) -> dict[tuple[str, str], dict]:
+    """Medians over seeds per (scenario, planner); speed, first solution from the longest runs."""
+    groups: dict[tuple[str, str], list[dict]] = {}
+    for record in records:
+        groups.setdefault((record["scenario"], record["planner"]), []).append(record)
+    summary = {}
+    for key, runs in groups.items():
+        longest = [r for r in runs if r["time_limit_s"] == budgets[-1]]
+        solved = [r for r in longest if r["solved"]]
+        summary[key] = {
+            "runs": len(longest),
+            "iterations_per_s": _median([r["iterations_per_s"] for r in longest]),
+            "ttfs_s": _median([r["time_to_first_solution_s"] for r in solved]),
+            "valid_5mm": sum(bool(r["valid_5mm"]) for r in solved) if key[1] != OURS else None,
+            "solved": len(solved),
+            "budgets": {b: _budget_summary([r for r in runs if r["time_limit_s"] == b])
+                        for b in budgets},
+        }
+    return summary
+
+
+def _budget_summary(runs: list[dict]) -> tuple[float | None, int]:
+    """(median cost of the solved runs, number solved)."""
+    return _median([r["cost"] for r in runs if r["solved"]]), sum(r["solved"] for r in runs)
+
+
+def _fmt(value: float | None, spec: str) -> str:
+    return "—" if value is None else format(value, spec)
+
+
+def _ratio(ours: float | None, theirs: float | None) -> str:
+    return "—" if ours is None or not theirs else f"{ours / theirs:.2f}"
+
+
+def results_table(summary: dict, scenarios: list[str], budgets: list[float]) -> str:
+    """Markdown table: one row per (scenario, planner)."""
+    budget_cols = " | ".join(f"cost {b:g} s (solved)" for b in budgets)
+    lines = [f"| scenario | planner | it/s | first solution ms | {budget_cols} | valid at 5 mm |",
+             "|---|---|---:|---:|" + "---:|" * len(budgets) + "---:|"]
+    for scenario in scenarios:
+        for planner in [*OMPL_PLANNERS, OURS]:
+            row = summary.get((scenario, planner))
+            if row is None:
+                continue
+            costs = " | ".join(f"{_fmt(cost, '.2f')} ({n}/{row['runs']})"
+                               for cost, n in (row["budgets"][b] for b in budgets))
+            valid = "—" if row["valid_5mm"] is None else f"{row['valid_5mm']}/{row['solved']}"
+            ttfs_ms = None if row["ttfs_s"] is None else row["ttfs_s"] * 1000
+            lines.append(f"| {scenario} | {planner} | {_fmt(row['iterations_per_s'], '.0f')} | "
+                         f"{_fmt(ttfs_ms, '.0f')} | {costs} | {valid} |")
+    return "\n".join(lines)
+
+
+def ratios_table(summary: dict, scenarios: list[str], budgets: list[float]) -> str:
+    """Markdown table of ours against OMPL RRT* (speed, first solution) and the best OMPL cost."""
+    lines = ["| scenario | it/s ours / RRT* | first solution ours / RRT* | "
+             f"cost {budgets[-1]:g} s ours / best OMPL |", "|---|---:|---:|---:|"]
+    for scenario in scenarios:
+        ours, rrtstar = summary.get((scenario, OURS)), summary.get((scenario, "RRTstar"))
+        if ours is None or rrtstar is None:
+            continue
+        best_cost, best = _best_ompl_cost(summary, scenario, budgets[-1])
+        speed = _ratio(ours["iterations_per_s"], rrtstar["iterations_per_s"])
+        lines.append(f"| {scenario} | {speed} | {_ratio(ours['ttfs_s'], rrtstar['ttfs_s'])} | "
+                     f"{_ratio(ours['budgets'][budgets[-1]][0], best_cost)} ({best}) |")
+    return "\n".join(lines)
+
+
+def _best_ompl_cost(summary: dict, scenario: str, budget: float) -> tuple[float | None, str]:
+    """(lowest median OMPL cost at `budget`, the planner that reached it)."""
+    costs = [(summary[(scenario, p)]["budgets"][budget][0], p) for p in OMPL_PLANNERS
+             if (scenario, p) in summary]
+    costs = [(cost, p) for cost, p in costs if cost is not None]
+    return min(costs) if costs else (None, "—")
+
+
+NOTES = (
+    "Medians over seeds (cost and first solution over the solved runs); it/s and first solution "
+    "come from the runs at the longest budget. Iterations: RRT* loop iterations, BIT* queue "
+    "iterations (edges and vertices processed), ours as its solve() reports them; per second of "
+    "planning, set-up not timed on either side. OMPL checks motions every 0.02 m; \"valid at "
+    "5 mm\" re-checks its returned paths every 5 mm. OMPL's seed is the run's seed + 1 (OMPL "
+    "refuses 0)."
+)
+
+
+def _revision() -> str:
+    """The checkout's commit, `-dirty` when the working tree has changes: what was measured."""
+    git = ["git", "describe", "--always", "--dirty"]
+    done = subprocess.run(git, cwd=Path(__file__).parent, capture_output=True, text=True)
+    return done.stdout.strip() or "(not a git checkout)"
+
+
+def report(summary: dict, args: argparse.Namespace, command: str, seconds: float) -> str:
+    """The whole Markdown report: how it was run, the table, the ratios when both sides ran."""
+    parts = [
+        "# Planner benchmark: Trackstar vs OMPL (Dubins)",
+        f"`{command}` — Trackstar {_revision()}, {date.today()}, {platform.machine()}, "
+        f"Python {platform.python_version()}, seeds {args.seeds}, {seconds:.0f} s in all; load "
+        f"average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs at the end (above ~1, other "
+        "processes shared the CPU and the speeds are low).",
+        NOTES,
+        results_table(summary, args.scenarios, args.budgets),
+    ]
+    if args.only is None:
+        parts.append(ratios_table(summary, args.scenarios, args.budgets))
+    return "\n\n".join(parts) + "\n"
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = parse_args(argv)
+    paths = {name: args.scenario_dir / f"{name}.json" for name in args.scenarios}
+    scenarios = {name: json.loads(path.read_text()) for name, path in paths.items()}
+    runs_per_planner = len(paths) * len(args.seeds)
+    n_ompl = 0 if args.only == OURS else runs_per_planner * len(OMPL_PLANNERS) * len(args.budgets)
+    n_ours = 0 if args.only == "ompl" else runs_per_planner
+
+    ours = _our_planner() if n_ours else None  # fails before the OMPL runs, not after them
+    start = time.perf_counter()
+    records: list[dict] = []
+    with tqdm(total=n_ompl + n_ours, unit="run") as bar:
+        if n_ours:
+            records += our_runs(ours, paths, args.seeds, args.budgets, bar)
+        if n_ompl:
+            records += ompl_runs(scenarios, args.seeds, args.budgets, bar)
+    options = sys.argv[1:] if argv is None else argv
+    command = " ".join(["python benchmarks/bench_planner.py", *options])
+    text = report(summarise(records, args.budgets), args, command, time.perf_counter() - start)
+
+    print(text)
+    RESULTS_MD.parent.mkdir(exist_ok=True)
+    RESULTS_MD.write_text(text)
+    if args.json:
+        args.json.write_text(json.dumps(records, indent=1))
+
+
+if __name__ == "__main__":
+    main()

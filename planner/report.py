@@ -1,0 +1,58 @@
+"""The machine-readable outcome of a plan: one pydantic model for the CLI's JSON and the API."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from pydantic import BaseModel, Field
+
+from planner.rrt import Result
+
+__all__ = ["PlanReport", "plan_report"]
+
+
+class PlanReport(BaseModel):
+    """What `trackstar plan --json` prints (and POST /plan returns)."""
+
+    scenario: str
+    solved: bool
+    cost: float | None = Field(description="driven length of the best path (m)")
+    time_to_first_solution_s: float | None
+    iterations: int
+    nodes: int
+    collision_checks: int = Field(description="motion checks (each exact, over a whole edge)")
+    min_clearance_m: float | None = Field(description="over the path, every 5 mm, in space-time")
+    max_abs_curvature: float | None
+    arrival_time_s: float | None = Field(None, description="only with moving obstacles")
+    planning_time_s: float
+    rewires: int
+    refused_rewires: int = Field(description="rewires refused: the subtree would collide at "
+                                             "its new arrival times")
+    cost_over_time: list[tuple[float, float]]
+    path: list[list[float]] = Field(description="[x, y, theta] (plus t with moving obstacles) "
+                                                "every ≤ 0.05 m from the start to the goal node")
+    parameters: dict
+
+
+def _clean(v: float | None) -> float | None:
+    return None if v is None or not math.isfinite(v) else float(v)
+
+
+def plan_report(result: Result, scenario_name: str, budget: dict) -> PlanReport:
+    """Build the report; ``budget`` holds the time/iteration limits the run was given."""
+    columns = [0, 1, 2, 5] if result.timed else [0, 1, 2]
+    path = result.path[:, columns].round(6).tolist() if result.solved else []
+    settings = dataclasses.asdict(result.settings)
+    return PlanReport(
+        scenario=scenario_name, solved=result.solved, cost=_clean(result.cost),
+        time_to_first_solution_s=_clean(result.time_to_first_solution_s),
+        iterations=result.iterations, nodes=result.nodes,
+        collision_checks=result.collision_checks, min_clearance_m=_clean(result.min_clearance_m),
+        max_abs_curvature=_clean(result.max_abs_curvature),
+        arrival_time_s=(float(result.path[-1, 5]) if result.timed and result.solved else None),
+        planning_time_s=result.planning_time_s, rewires=result.rewires,
+        refused_rewires=result.refused_rewires,
+        cost_over_time=[(round(t, 6), c) for t, c in result.cost_over_time], path=path,
+        parameters={**settings, **budget, "motion_check": "exact (clearance stepping)"},
+    )
