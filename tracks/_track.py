@@ -1,0 +1,167 @@
+"""A track: an exact centreline in metres (world frame, y up), a width, loop or road."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tracks._arclength import LengthTable, length_table, params_at
+from tracks._errors import TrackError
+from tracks._profile import Profile, driving_profile
+from tracks._chain import Chain
+from tracks._segments import Segment
+
+STEERING_COLUMNS = ("s", "x", "y", "heading", "steering_deg")
+
+
+def _positive(name: str, value: float) -> float:
+    if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+        raise TrackError(f"{name} must be a positive number of metres, got {value!r}")
+    return float(value)
+
+
+@dataclass(frozen=True, eq=False)
+class Track:
+    """Centreline segments in metres, world frame; built by `load_svg` or from segments.
+
+    Zero-length segments are dropped on construction; their lengths are measured once, by
+    adaptive Gauss–Legendre quadrature. Profiles are cached per (spacing, wheelbase, δmax).
+    """
+
+    name: str
+    closed: bool
+    width_m: float
+    segments: tuple[Segment, ...]
+    chain: Chain = field(init=False, repr=False)
+    table: LengthTable = field(init=False, repr=False)
+    _profiles: dict = field(init=False, repr=False, default_factory=dict)
+    _targets: dict = field(init=False, repr=False, default_factory=dict)
+
+    def __post_init__(self) -> None:
+        _positive("width", self.width_m)
+        chain = Chain(self.segments)
+        table = length_table(chain.velocity, chain.count)
+        keep = table.segment_lengths(chain.count) > 1e-12 * table.length
+        if not keep.any():
+            raise TrackError(f"track {self.name!r} has zero length")
+        if not keep.all():
+            object.__setattr__(self, "segments", tuple(np.asarray(self.segments, dtype=object)[keep]))
+            chain = Chain(self.segments)
+            table = length_table(chain.velocity, chain.count)
+        object.__setattr__(self, "chain", chain)
+        object.__setattr__(self, "table", table)
+
+    @property
+    def length_m(self) -> float:
+        return self.table.length
+
+    def points_at(self, s: np.ndarray) -> np.ndarray:
+        """World points (n, 2) at arc lengths ``s`` from the start (clipped to the track)."""
+        idx, t = params_at(self.chain.velocity, self.table, np.atleast_1d(s))
+        return self.chain.point(idx, t)
+
+    def bbox(self) -> tuple[float, float, float, float]:
+        """Exact (xmin, ymin, xmax, ymax) of the centreline: ends and axis extrema of segments."""
+        pts = np.concatenate(
+            [seg.point(np.concatenate([[0.0, 1.0], seg.extremum_params()])) for seg in self.segments]
+        )
+        (xmin, ymin), (xmax, ymax) = pts.min(axis=0), pts.max(axis=0)
+        return float(xmin), float(ymin), float(xmax), float(ymax)
+
+    def sample(
+        self, spacing: float = 0.02, wheelbase: float = 0.44, max_steer_deg: float = 26.0
+    ) -> Profile:
+        """Target points every ``spacing`` metres with heading, curvature and steering angle."""
+        key = (_positive("spacing", spacing), _positive("wheelbase", wheelbase), max_steer_deg)
+        if not 0 < max_steer_deg < 90:
+            raise TrackError(f"max steering angle must be in (0, 90) degrees, got {max_steer_deg}")
+        if key not in self._profiles:
+            self._profiles[key] = driving_profile(
+                self.chain,
+                self.table,
+                closed=self.closed,
+                spacing=spacing,
+                wheelbase=wheelbase,
+                max_steer_deg=max_steer_deg,
+            )
+        return self._profiles[key]
+
+    def boundaries(self, spacing: float = 0.02) -> tuple[np.ndarray, np.ndarray]:
+        """Left and right edges (each (N, 2)): the centreline offset by ±width/2 along the normal.
+
+        Where the curvature radius is below width/2 an offset curve folds over itself; use
+        `region_rings` for the drivable area itself.
+        """
+        prof = self.sample(spacing)
+        half = self.width_m / 2.0
+        centre = np.column_stack([prof.x, prof.y])
+        normal = np.column_stack([-np.sin(prof.heading), np.cos(prof.heading)])
+        return centre + half * normal, centre - half * normal
+
+    def region_rings(self, spacing: float = 0.05) -> list[np.ndarray]:
+        """The drivable region as polygon rings (each (N, 2), not repeating its first point).
+
+        The sampled centreline is buffered by width/2 (flat ends, mitred joins), which stays
+        right where the offset curves fold. A loop gives [outer, inner], a road one ring; any
+        point is drivable iff it is inside an odd number of rings.
+        """
+        import shapely
+
+        prof = self.sample(spacing)
+        centre = np.column_stack([prof.x, prof.y])
+        line = shapely.LinearRing(centre[:-1]) if self.closed else shapely.LineString(centre)
+        region = line.buffer(self.width_m / 2.0, cap_style="flat", join_style="mitre")
+        polygons = getattr(region, "geoms", [region])
+        rings = [ring for poly in polygons for ring in (poly.exterior, *poly.interiors)]
+        return [np.asarray(ring.coords)[:-1] for ring in rings]
+
+    def steering_commands(
+        self,
+        x: float,
+        y: float,
+        heading: float,
+        n: int = 10,
+        spacing: float = 0.02,
+        wheelbase: float = 0.44,
+    ) -> np.ndarray:
+        """The next ``n`` target points ahead of a pose, columns `STEERING_COLUMNS`.
+
+        The pose is projected onto the nearest resampled point, where distance is charged
+        width²·(1 − cos Δheading)/2 extra so that at a crossing or a hairpin the branch the car
+        is driving along wins. Targets are the following resampled points (wrapping on a loop,
+        repeating the end on a road) with the feed-forward steering δ = atan(L·κ) there.
+        """
+        table = self._targets.get((spacing, wheelbase))
+        if table is None:
+            table = self._target_table(spacing, wheelbase)
+        dx, dy = table[:, 1] - x, table[:, 2] - y
+        facing = table[:, 5] * math.cos(heading) + table[:, 6] * math.sin(heading)
+        cost = dx * dx + dy * dy + (0.5 * self.width_m**2) * (1.0 - facing)
+        nearest = int(np.argmin(cost))
+        ahead = dx[nearest] * table[nearest, 5] + dy[nearest] * table[nearest, 6] > 0
+        first = nearest if ahead else nearest + 1
+        idx = np.arange(first, first + n)
+        if self.closed:
+            idx %= len(table)
+        else:
+            idx = np.minimum(idx, len(table) - 1)
+        return table[idx, :5]
+
+    def _target_table(self, spacing: float, wheelbase: float) -> np.ndarray:
+        """Profile columns plus cos/sin of the heading, the loop's repeated end point dropped."""
+        prof = self.sample(spacing, wheelbase)
+        table = np.column_stack(
+            [prof.s, prof.x, prof.y, prof.heading, prof.steering_deg,
+             np.cos(prof.heading), np.sin(prof.heading)]
+        )
+        table = table[:-1] if self.closed else table
+        self._targets[(spacing, wheelbase)] = table
+        return table
+
+    def to_svg(self) -> str:
+        """An Inkscape SVG (mm document, one layer, stroke width = track width) of this track."""
+        from tracks._svg_export import track_to_svg
+
+        return track_to_svg(self)
