@@ -25,6 +25,14 @@ def _mod2pi(a: float) -> float:
     return 0.0 if r > _TWO_PI - 1e-12 else r
 
 
+_ZERO = -1e-9  # tolerate rounding in exactly tangent cases (a pure arc: the straight is 0)
+
+
+@njit(cache=True, inline="always")
+def _sqrt0(v: float) -> float:
+    return math.sqrt(max(v, 0.0))
+
+
 @njit(cache=True, inline="always")
 def _keep(best, i, t, p, q):
     """Keep word i if it is shorter than ``best`` = (index, t, p, q)."""
@@ -34,8 +42,13 @@ def _keep(best, i, t, p, q):
 
 
 @njit(cache=True)
-def _shortest_word(x0, y0, th0, x1, y1, th1, rho):
-    """(word index, t, p, q) of the shortest word, lengths normalised by ρ. No allocation."""
+def _shortest_word(x0, y0, th0, x1, y1, th1, rho, bound):
+    """(word index, t, p, q) of the shortest word, lengths normalised by ρ. No allocation.
+
+    Words that cannot beat ``bound`` (normalised) are skipped as soon as that is known: the
+    middle segment p of a CSC word costs one square root, its outer arcs two atan2 more, and a
+    CCC word is never shorter than π. The result is index -1 when nothing beats the bound.
+    """
     dx = (x1 - x0) / rho
     dy = (y1 - y0) / rho
     d = math.hypot(dx, dy)
@@ -44,29 +57,31 @@ def _shortest_word(x0, y0, th0, x1, y1, th1, rho):
     b = _mod2pi(th1 - theta)
     sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
     cab = ca * cb + sa * sb
-    best = (-1, math.inf, 0.0, 0.0)
+    best = (-1, bound, 0.0, 0.0)
     # LSL
     tmp = 2.0 + d * d - 2.0 * cab + 2.0 * d * (sa - sb)
-    if tmp >= 0.0:
+    if tmp >= _ZERO and _sqrt0(tmp) < best[1] + best[2] + best[3]:
         th = math.atan2(cb - ca, d + sa - sb)
-        best = _keep(best, 0, _mod2pi(-a + th), math.sqrt(tmp), _mod2pi(b - th))
+        best = _keep(best, 0, _mod2pi(-a + th), _sqrt0(tmp), _mod2pi(b - th))
     # RSR
     tmp = 2.0 + d * d - 2.0 * cab + 2.0 * d * (sb - sa)
-    if tmp >= 0.0:
+    if tmp >= _ZERO and _sqrt0(tmp) < best[1] + best[2] + best[3]:
         th = math.atan2(ca - cb, d - sa + sb)
-        best = _keep(best, 1, _mod2pi(a - th), math.sqrt(tmp), _mod2pi(-b + th))
+        best = _keep(best, 1, _mod2pi(a - th), _sqrt0(tmp), _mod2pi(-b + th))
     # RSL
     tmp = d * d - 2.0 + 2.0 * cab - 2.0 * d * (sa + sb)
-    if tmp >= 0.0:
-        p = math.sqrt(tmp)
+    if tmp >= _ZERO and _sqrt0(tmp) < best[1] + best[2] + best[3]:
+        p = _sqrt0(tmp)
         th = math.atan2(ca + cb, d - sa - sb) - math.atan2(2.0, p)
         best = _keep(best, 2, _mod2pi(a - th), p, _mod2pi(b - th))
     # LSR
     tmp = -2.0 + d * d + 2.0 * cab + 2.0 * d * (sa + sb)
-    if tmp >= 0.0:
-        p = math.sqrt(tmp)
+    if tmp >= _ZERO and _sqrt0(tmp) < best[1] + best[2] + best[3]:
+        p = _sqrt0(tmp)
         th = math.atan2(-ca - cb, d + sa + sb) - math.atan2(-2.0, p)
         best = _keep(best, 3, _mod2pi(-a + th), p, _mod2pi(-b + th))
+    if best[1] + best[2] + best[3] <= math.pi:
+        return best  # CCC words are never shorter than π
     # RLR
     tmp = 0.125 * (6.0 - d * d + 2.0 * cab + 2.0 * d * (sa - sb))
     if abs(tmp) <= 1.0:
@@ -87,7 +102,7 @@ def _shortest_word(x0, y0, th0, x1, y1, th1, rho):
 @njit(cache=True)
 def dubins_path(x0, y0, th0, x1, y1, th1, rho, kinds_out, lens_out) -> float:
     """Shortest Dubins path from pose 0 to pose 1; fills kinds_out/lens_out, returns its length."""
-    i, t, p, q = _shortest_word(x0, y0, th0, x1, y1, th1, rho)
+    i, t, p, q = _shortest_word(x0, y0, th0, x1, y1, th1, rho, math.inf)
     kinds_out[:] = 0
     lens_out[:] = 0.0
     kinds_out[0] = _WORDS[i, 0]
@@ -101,7 +116,25 @@ def dubins_path(x0, y0, th0, x1, y1, th1, rho, kinds_out, lens_out) -> float:
 
 @njit(cache=True)
 def dubins_length(x0, y0, th0, x1, y1, th1, rho, bound) -> float:
-    """Length of the shortest Dubins path (``bound`` is unused: all six words cost about the same,
-    so there is nothing to skip; it keeps the signature of the Reeds-Shepp twin)."""
-    _, t, p, q = _shortest_word(x0, y0, th0, x1, y1, th1, rho)
-    return (t + p + q) * rho
+    """Length of the shortest Dubins path, or ``bound`` itself as soon as no word can beat it."""
+    i, t, p, q = _shortest_word(x0, y0, th0, x1, y1, th1, rho, bound / rho)
+    return bound if i < 0 else (t + p + q) * rho
+
+
+@njit(cache=True, inline="always")
+def dubins_to_point(x, y, th, px, py, rho) -> float:
+    """Shortest forward path from a pose to a *point* (any final heading): a lower bound of
+    every Dubins length to a pose at that point.
+
+    Outside both turning circles the optimum is CS, turning towards the point's side first
+    (Bui, Souères, Boissonnat & Laumond 1994); inside one we fall back to the straight line.
+    """
+    c, s = math.cos(th), math.sin(th)
+    dx, dy = px - x, py - y
+    u = c * dx + s * dy
+    v = abs(-s * dx + c * dy)  # mirror to the left side
+    dc = math.hypot(u, v - rho)
+    if dc < rho:
+        return math.hypot(u, v)
+    phi = _mod2pi(math.atan2(v - rho, u) + 0.5 * math.pi - math.acos(rho / dc))
+    return rho * phi + math.sqrt(dc * dc - rho * rho)

@@ -21,6 +21,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from planner._dubins import dubins_to_point
 from planner._paths import path_end, truncate, wrap_angle
 from planner._rng import uniform
 from planner._steer import steer_length, steer_path
@@ -163,13 +164,33 @@ def _sample(tree: Tree, w: World, P: np.ndarray):
 def _scan_cell(tree: Tree, P, c, qx, qy, qth, best, besti):
     node = tree.cell_head[c]
     while node >= 0:
-        x, y = tree.pose[node, 0], tree.pose[node, 1]
-        if math.hypot(qx - x, qy - y) < best:
-            d = steer_length(P[REVERSE], x, y, tree.pose[node, 2], qx, qy, qth, P[RHO], best)
+        if _lower_bound(tree, P, node, qx, qy, qth, best) < best:
+            d = steer_length(P[REVERSE], tree.pose[node, 0], tree.pose[node, 1],
+                             tree.pose[node, 2], qx, qy, qth, P[RHO], best)
             if d < best:
                 best, besti = d, node
         node = tree.cell_next[node]
     return best, besti
+
+
+@njit(cache=True, inline="always")
+def _lower_bound(tree: Tree, P, node, qx, qy, qth, best) -> float:
+    """A cheap lower bound of the car path length from a node to a pose, tightened in steps
+    only while it stays below ``best``.
+
+    Every path is at least the straight line and turns the heading by at least |Δθ| at
+    curvature ≤ 1/ρ. A forward-only (Dubins) path is moreover at least the shortest path to
+    the query's position ignoring its heading, and — driven backwards from the query — at
+    least the shortest path from the query to the node's position.
+    """
+    x, y, th = tree.pose[node, 0], tree.pose[node, 1], tree.pose[node, 2]
+    e = max(math.hypot(qx - x, qy - y), P[RHO] * abs(wrap_angle(qth - th)))
+    if e >= best or P[REVERSE] > 0.0:
+        return e
+    a = dubins_to_point(x, y, th, qx, qy, P[RHO])
+    if a >= best:
+        return a
+    return max(a, dubins_to_point(qx, qy, qth + math.pi, x, y, P[RHO]))
 
 
 @njit(cache=True)
@@ -179,10 +200,11 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
     best, besti = math.inf, -1
     if n <= 32:
         for node in range(n):
-            x, y = tree.pose[node, 0], tree.pose[node, 1]
-            d = steer_length(P[REVERSE], x, y, tree.pose[node, 2], qx, qy, qth, P[RHO], best)
-            if d < best:
-                best, besti = d, node
+            if _lower_bound(tree, P, node, qx, qy, qth, best) < best:
+                d = steer_length(P[REVERSE], tree.pose[node, 0], tree.pose[node, 1],
+                                 tree.pose[node, 2], qx, qy, qth, P[RHO], best)
+                if d < best:
+                    best, besti = d, node
         return besti, best
     nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
     ci, cj = _cell(tree, qx, qy)
@@ -352,6 +374,8 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
     for _ in range(n_iter):
         if tree.cnt[N] >= tree.pose.shape[0]:
             return False
+        if P[STAR] == 0.0 and tree.cnt[BEST] >= 0:
+            break  # RRT ends at its first solution, whatever the batch size
         tree.cnt[ITER] += 1
         xr, yr, thr = _sample(tree, w, P)
         near_i, dist = nearest(tree, P, xr, yr, thr)

@@ -43,6 +43,8 @@ class World(NamedTuple):
     m_vel: np.ndarray  # (nm, 2)
     m_wp_start: np.ndarray  # (nm + 1,)
     m_wp: np.ndarray  # (nw, 3) t, dx, dy
+    sdf: np.ndarray  # (nx, ny) static clearance at cell centres (a lower-bound lookup table)
+    sdf_geo: np.ndarray  # float64[3]: x0, y0, cell size
 
 
 def _edges(points: np.ndarray) -> np.ndarray:
@@ -85,8 +87,14 @@ def build_world(bounds, radius, circles, polygons, motions, rings=()) -> World:
     m_wp_start = np.concatenate([[0], np.cumsum([len(w) for w in wps])]).astype(np.int64)
     m_wp = np.vstack(wps) if wps else np.zeros((0, 3))
     geo = np.array([*bounds, radius, vmax, 1.0 if len(ring_edges) else 0.0], dtype=float)
-    return World(geo, circ, circ_motion, poly_edges, poly_start, poly_bbox, poly_motion,
-                 ring_edges, m_kind, m_vel, m_wp_start, m_wp)
+    xmin, ymin, xmax, ymax = bounds
+    h = max(math.hypot(xmax - xmin, ymax - ymin) / 500.0, 0.01)
+    nx, ny = math.ceil((xmax - xmin) / h), math.ceil((ymax - ymin) / h)
+    world = World(geo, circ, circ_motion, poly_edges, poly_start, poly_bbox, poly_motion,
+                  ring_edges, m_kind, m_vel, m_wp_start, m_wp, np.zeros((nx, ny)),
+                  np.array([xmin, ymin, h]))
+    _fill_sdf(world)
+    return world
 
 
 @njit(cache=True)
@@ -138,20 +146,15 @@ def _edges_distance(edges, a, b, px, py):
 
 
 @njit(cache=True)
-def clearance(w: World, x: float, y: float, t: float) -> float:
-    """Signed clearance of the car's disc at (x, y) at time t; > 0 means valid.
-
-    ``t`` NaN means "static obstacles only" (FORMAT.md: the goal has no time condition).
-    """
+def _obstacle_clearance(w: World, x: float, y: float, t: float, moving: bool, c: float) -> float:
+    """min(c, clearance to the moving (or the static) obstacles at time t)."""
     r = w.geo[RADIUS]
-    c = min(x - w.geo[XMIN], w.geo[XMAX] - x, y - w.geo[YMIN], w.geo[YMAX] - y) - r
-    ignore_moving = t != t
     for i in range(w.circ.shape[0]):
-        cx, cy = w.circ[i, 0], w.circ[i, 1]
         m = w.circ_motion[i]
-        if m >= 0:
-            if ignore_moving:
-                continue
+        if (m >= 0) != moving:
+            continue
+        cx, cy = w.circ[i, 0], w.circ[i, 1]
+        if moving:
             ox, oy = offset(w, m, t)
             cx += ox
             cy += oy
@@ -159,11 +162,11 @@ def clearance(w: World, x: float, y: float, t: float) -> float:
         if d < c:
             c = d
     for p in range(w.poly_bbox.shape[0]):
-        px, py = x, y
         m = w.poly_motion[p]
-        if m >= 0:
-            if ignore_moving:
-                continue
+        if (m >= 0) != moving:
+            continue
+        px, py = x, y
+        if moving:
             ox, oy = offset(w, m, t)
             px -= ox
             py -= oy
@@ -175,12 +178,61 @@ def clearance(w: World, x: float, y: float, t: float) -> float:
         d = -d - r if inside else d - r
         if d < c:
             c = d
+    return c
+
+
+@njit(cache=True)
+def _static_clearance(w: World, x: float, y: float) -> float:
+    """Exact clearance to the bounds, the drivable region and the obstacles that never move."""
+    r = w.geo[RADIUS]
+    c = min(x - w.geo[XMIN], w.geo[XMAX] - x, y - w.geo[YMIN], w.geo[YMAX] - y) - r
     if w.geo[HAS_REGION] > 0.0:
         d, inside = _edges_distance(w.ring_edges, 0, w.ring_edges.shape[0], x, y)
         d = d - r if inside else -d - r
         if d < c:
             c = d
-    return c
+    return _obstacle_clearance(w, x, y, 0.0, False, c)
+
+
+@njit(cache=True)
+def _fill_sdf(w: World) -> None:
+    x0, y0, h = w.sdf_geo[0], w.sdf_geo[1], w.sdf_geo[2]
+    for i in range(w.sdf.shape[0]):
+        for j in range(w.sdf.shape[1]):
+            w.sdf[i, j] = _static_clearance(w, x0 + (i + 0.5) * h, y0 + (j + 0.5) * h)
+
+
+@njit(cache=True)
+def clearance(w: World, x: float, y: float, t: float) -> float:
+    """Signed clearance of the car's disc at (x, y) at time t; > 0 means valid.
+
+    ``t`` NaN means "static obstacles only" (FORMAT.md: the goal has no time condition).
+    """
+    c = _static_clearance(w, x, y)
+    if t != t:
+        return c
+    return _obstacle_clearance(w, x, y, t, True, c)
+
+
+@njit(cache=True)
+def clearance_bound(w: World, x: float, y: float, t: float) -> float:
+    """A lower bound of `clearance`, exact near obstacles and O(1) in open space.
+
+    Clearance is 1-Lipschitz, so the value stored at the nearest cell centre minus the distance
+    to it (≤ h/√2) bounds it from below; only where that bound is small do we compute exactly.
+    """
+    x0, y0, h = w.sdf_geo[0], w.sdf_geo[1], w.sdf_geo[2]
+    i = int((x - x0) / h)
+    j = int((y - y0) / h)
+    if 0 <= i < w.sdf.shape[0] and 0 <= j < w.sdf.shape[1] and x >= x0 and y >= y0:
+        c = w.sdf[i, j] - 0.7072 * h
+        if c < 2.0 * h:
+            c = _static_clearance(w, x, y)
+    else:
+        c = _static_clearance(w, x, y)
+    if w.m_kind.shape[0] == 0:
+        return c
+    return _obstacle_clearance(w, x, y, t, True, c)
 
 
 @njit(cache=True)
@@ -201,7 +253,7 @@ def motion_free(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> boo
         while True:
             px, py, _ = advance(x, y, th, kinds[i], direction * s, rho)
             counter[0] += 1
-            d = clearance(w, px, py, t0 + (driven + s) / speed)
+            d = clearance_bound(w, px, py, t0 + (driven + s) / speed)
             if d <= CONTACT:
                 return False
             if s >= length:

@@ -184,6 +184,11 @@ class Planner:
         best = self._tree.cnt[K.BEST]
         return float(self._tree.cost[best]) if best >= 0 else None
 
+    @property
+    def finished(self) -> bool:
+        """RRT is done at its first solution; RRT* goes on improving."""
+        return self.settings.algorithm == "rrt" and self.solved
+
     def snapshot(self) -> TreeSnapshot:
         n = self.nodes
         t = self._tree
@@ -197,7 +202,7 @@ class Planner:
         done_before = self.iterations
         target = done_before + iterations
         t0 = time.perf_counter()
-        while self.iterations < target:
+        while self.iterations < target and not self.finished:
             if not K.iterate(self._tree, self.problem.world, self._P,
                              target - self.iterations, events):
                 self._tree = K.grown(self._tree, 2 * self._tree.pose.shape[0])
@@ -241,7 +246,7 @@ class Planner:
             t0 = time.perf_counter()
             self.step(n)
             took = time.perf_counter() - t0
-            if self.settings.algorithm == "rrt" and self.solved:
+            if self.finished:
                 break
             # Aim at ~2 ms batches: fine-grained budgets and cost-over-time samples.
             batch = max(1, min(4096, int(batch * (0.002 / took if took > 0 else 2.0))))

@@ -202,6 +202,9 @@ def _describe(exc: ValidationError) -> str:
         msg = f"unknown obstacle type '{tag}'{_suggest(tag, ['box', 'circle', 'polygon'])}"
     elif err["type"] == "union_tag_not_found":
         msg = "obstacle without 'type' (circle, polygon or box)"
+    elif "waypoints" in err["loc"] and err["type"] in ("missing", "too_long", "tuple_type"):
+        where = where.split(".waypoints")[0] + ".waypoints"
+        msg = f"each waypoint is [t, dx, dy], got {err.get('input')!r}"
     elif err["type"] == "finite_number":
         msg = "must be a finite number (NaN and infinity are not allowed)"
     return f"{where}: {msg}" if where else msg

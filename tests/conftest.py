@@ -1,0 +1,23 @@
+"""Shared fixtures: the reference scenarios of ../shared/scenarios and a scenario loader."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "shared" / "scenarios"
+if not SCENARIOS.is_dir():  # CI clones the repo with shared/ beside it
+    SCENARIOS = Path(__file__).resolve().parents[1].parent / "shared" / "scenarios"
+STATIC = ["open_field", "hallway", "slalom", "parking", "oval_track"]
+
+
+def scenario_dict(name: str) -> dict:
+    return json.loads((SCENARIOS / f"{name}.json").read_text())
+
+
+@pytest.fixture
+def scenarios_dir() -> Path:
+    assert SCENARIOS.is_dir(), f"reference scenarios not found at {SCENARIOS}"
+    return SCENARIOS

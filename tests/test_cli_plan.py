@@ -1,0 +1,93 @@
+"""`trackstar plan` and `trackstar scenario` through the installed console script."""
+
+import json
+import subprocess
+import time
+
+import pytest
+
+from conftest import SCENARIOS, scenario_dict
+
+
+def run(*args, timeout=120):
+    return subprocess.run(["trackstar", *args], capture_output=True, text=True, timeout=timeout)
+
+
+def test_plan_prints_one_json_object_with_the_contract_keys():
+    out = run("plan", str(SCENARIOS / "slalom.json"), "--json", "--time", "0.5")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    for key in ("solved", "cost", "time_to_first_solution_s", "iterations", "nodes",
+                "collision_checks", "min_clearance_m", "path", "parameters"):
+        assert key in data
+    assert data["solved"] and all(len(p) == 3 for p in data["path"])
+    assert data["parameters"]["algorithm"] == "rrtstar" and data["parameters"]["time"] == 0.5
+    assert data["parameters"]["seed"] == 0 and data["parameters"]["eps"] > 0
+
+
+def test_plan_with_iterations_is_reproducible_and_echoes_options():
+    args = ("plan", str(SCENARIOS / "open_field.json"), "--json", "--iterations", "800",
+            "--seed", "3", "--planner", "rrt", "--steering", "dubins")
+    a, b = json.loads(run(*args).stdout), json.loads(run(*args).stdout)
+    assert a["path"] == b["path"] and a["iterations"] == b["iterations"]
+    assert a["parameters"]["algorithm"] == "rrt" and a["parameters"]["iterations"] == 800
+    assert a["parameters"]["time"] is None
+
+
+def test_moving_obstacles_give_timed_paths():
+    data = json.loads(run("plan", str(SCENARIOS / "crossing.json"), "--json",
+                          "--iterations", "2000").stdout)
+    assert data["solved"] and all(len(p) == 4 for p in data["path"])
+    assert data["arrival_time_s"] == pytest.approx(data["path"][-1][3])
+
+
+def test_human_summary_without_json():
+    out = run("plan", str(SCENARIOS / "slalom.json"), "--iterations", "1500")
+    assert out.returncode == 0 and "cost" in out.stdout and "iterations" in out.stdout
+
+
+def test_unsolved_is_exit_0_with_solved_false(tmp_path):
+    scn = scenario_dict("open_field")
+    scn["obstacles"].append({"type": "polygon", "points": [[0, 10], [20, 10], [20, 10.5],
+                                                           [0, 10.5]]})
+    path = tmp_path / "walled.json"
+    path.write_text(json.dumps(scn))
+    out = run("plan", str(path), "--json", "--iterations", "500")
+    assert out.returncode == 0
+    data = json.loads(out.stdout)
+    assert data["solved"] is False and data["path"] == [] and data["cost"] is None
+
+
+@pytest.mark.parametrize("content, message", [
+    (None, "no such scenario file"),
+    ("{not json", "not valid JSON"),
+    ('{"name": "x", "bounds": [0, 0, 1, 1], "start": [0.5, 0.5, 0], "goal": [0.6, 0.6, 0], '
+     '"obstacles": [], "vehicel": {}}', "did you mean 'vehicle'"),
+    ('{"name": "x", "bounds": [0, 0, 1, 1], "start": [0.5, 0.5, 0], "goal": [0.6, 0.6, 0], '
+     '"obstacles": [{"type": "circle", "center": [0.5, 0.5], "radius": 0.2}]}', "start"),
+    ('{"name": "x", "bounds": [0, 0, 1, 1], "start": [NaN, 0.5, 0], "goal": [0.6, 0.6, 0], '
+     '"obstacles": []}', "NaN"),
+    ('[1, 2]', "JSON object"),
+])
+def test_bad_input_exits_2_with_one_line_quickly(tmp_path, content, message):
+    path = tmp_path / "bad.json"
+    if content is not None:
+        path.write_text(content)
+    started = time.perf_counter()
+    out = run("plan", str(path), "--json")
+    assert time.perf_counter() - started < 10
+    assert out.returncode == 2
+    assert out.stdout == ""
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0]
+
+
+def test_bad_options_exit_2():
+    assert run("plan", str(SCENARIOS / "slalom.json"), "--planner", "prm").returncode == 2
+    assert run("plan", str(SCENARIOS / "slalom.json"), "--time", "-1").returncode == 2
+
+
+def test_scenario_schema_and_check():
+    schema = json.loads(run("scenario", "schema").stdout)
+    assert schema["title"] == "Scenario"
+    assert run("scenario", "check", str(SCENARIOS / "crossing.json")).returncode == 0

@@ -1,0 +1,111 @@
+"""RRT and RRT* on the reference scenarios, validated by the independent checker."""
+
+import math
+
+import numpy as np
+import pytest
+
+import planner
+from checker import arc_mismatch, first_collision
+from conftest import STATIC, scenario_dict
+
+
+def plan(name, iterations=3000, **kw):
+    scn = planner.parse_scenario(scenario_dict(name))
+    return planner.solve(scn, time_limit=None, iterations=iterations, **kw)
+
+
+@pytest.mark.parametrize("name", STATIC)
+@pytest.mark.parametrize("steering", ["dubins"])
+def test_paths_are_valid_continuous_and_feasible(name, steering):
+    result = plan(name, iterations=4000, steering=steering)
+    assert result.solved, f"{name} not solved in 4000 iterations"
+    scn = scenario_dict(name)
+    path = result.path
+    rho = 0.44 / math.tan(math.radians(26))
+    assert path[0, :3] == pytest.approx(scn["start"], abs=1e-12)
+    gx, gy, gth = scn["goal"]
+    assert math.hypot(path[-1, 0] - gx, path[-1, 1] - gy) <= 0.25 + 1e-9
+    assert abs(math.remainder(path[-1, 2] - gth, 2 * math.pi)) <= math.radians(20) + 1e-9
+    assert np.all(np.hypot(*np.diff(path[:, :2], axis=0).T) <= 0.05 + 1e-9)
+    assert np.all(np.abs(path[:, 3]) <= 1 / rho + 1e-9)
+    assert arc_mismatch(path[:, :3]) < 1e-6
+    assert first_collision(scn, path[:, :3]) is None
+    # The reported cost is the driven length of the returned path.
+    steps = np.hypot(*np.diff(path[:, :2], axis=0).T)
+    assert result.cost == pytest.approx(steps.sum(), rel=2e-3)
+    assert result.min_clearance_m > 0
+
+
+def test_same_seed_same_tree_other_seed_other_tree():
+    a = plan("slalom", iterations=1500, seed=7)
+    b = plan("slalom", iterations=1500, seed=7)
+    c = plan("slalom", iterations=1500, seed=8)
+    assert a.cost == b.cost and a.nodes == b.nodes and np.array_equal(a.path, b.path)
+    assert (c.cost, c.nodes) != (a.cost, a.nodes)
+
+
+def test_rrtstar_cost_never_increases():
+    result = plan("open_field", iterations=6000)
+    costs = [c for _, c in result.cost_over_time]
+    assert len(costs) > 3
+    assert all(b <= a for a, b in zip(costs, costs[1:]))
+
+
+def test_rrtstar_beats_rrt_on_average_over_seeds():
+    star = [plan("slalom", iterations=3000, seed=s).cost for s in range(4)]
+    rrt = [plan("slalom", iterations=3000, seed=s, algorithm="rrt").cost for s in range(4)]
+    assert np.mean(star) < np.mean(rrt)
+
+
+def test_rrt_stops_at_its_first_solution():
+    result = plan("open_field", iterations=20000, algorithm="rrt")
+    assert result.solved and result.iterations < 20000
+    assert len(result.cost_over_time) == 1
+
+
+def test_events_report_every_iteration_and_cost_nothing_without_listener():
+    scn = planner.parse_scenario(scenario_dict("slalom"))
+    problem = planner.compile_problem(scn)
+    seen = []
+    watched = planner.Planner(problem)
+    watched.add_listener(seen.append)
+    for _ in range(200):
+        watched.step(1)
+    quiet = planner.Planner(problem)
+    quiet.step(200)
+    # Observing does not change the run.
+    assert np.array_equal(watched.snapshot().pose, quiet.snapshot().pose)
+    rows = np.vstack([e.rows for e in seen])
+    assert len(rows) == 200 and list(rows[:, 0]) == list(range(1, 201))
+    rewires = np.vstack([e.rewires for e in seen if len(e.rewires)] or [np.zeros((0, 4))])
+    snap = watched.snapshot()
+    for it, node, old, new in rewires.astype(int):
+        assert old != new
+    if len(rewires):
+        # The last rewire of each node is its current parent.
+        last = {int(n): int(p) for _, n, _, p in rewires}
+        assert all(snap.parent[n] == p for n, p in last.items())
+
+
+def test_unsolvable_scenario_reports_unsolved():
+    scn = scenario_dict("open_field")
+    scn["obstacles"].append({"type": "circle", "center": [19, 19], "radius": 0.1})
+    scn["goal"] = [19.0, 17.0, 1.5708]
+    # A wall across the field: no way through.
+    scn["obstacles"].append({"type": "polygon", "points": [[0, 10], [20, 10], [20, 10.5],
+                                                           [0, 10.5]]})
+    result = planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=1500)
+    assert not result.solved and result.cost is None and len(result.path) == 0
+
+
+@pytest.mark.parametrize("mutate, message", [
+    (lambda s: s.update(start=[5.0, 5.0, 0.0]), "start"),  # inside a circle? checked below
+    (lambda s: s.update(goal=[-1.0, 5.0, 0.0]), "goal"),
+])
+def test_start_or_goal_in_collision_is_rejected(mutate, message):
+    scn = scenario_dict("slalom")
+    mutate(scn)
+    scn["obstacles"].append({"type": "circle", "center": [5.0, 5.0], "radius": 0.5})
+    with pytest.raises(planner.ScenarioError, match=message):
+        planner.compile_problem(planner.parse_scenario(scn))
