@@ -29,7 +29,7 @@ from planner._world import World, motion_free
 
 # Parameter vector indices.
 (EPS, GAMMA, GOAL_BIAS, RHO, SPEED, GX, GY, GTH, GPOS, GHEAD, INFORMED, STAR, REVERSE,
- SX, SY, NPARAMS) = range(16)
+ SX, SY, K_RRT, NPARAMS) = range(17)
 # Counter indices.
 N, NGOAL, ITER, CHECKS, BEST, REWIRES, EVALS, FIRST_ITER, REFUSED = range(9)
 # Event row columns (only written when the event buffers are non-empty).
@@ -208,35 +208,77 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
         return besti, best
     nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
     ci, cj = _cell(tree, qx, qy)
+    cells = np.empty(8 * (max(nx, ny) + 1), np.int64)
     for k in range(max(nx, ny) + 1):
         if k >= 2 and (k - 1) * cell > best:
             break
-        for i in range(ci - k, ci + k + 1):
-            if i < 0 or i >= nx:
-                continue
-            step = 2 * k if 0 < k and i != ci - k and i != ci + k else 1
-            j = cj - k
-            while j <= cj + k:
-                if 0 <= j < ny:
-                    best, besti = _scan_cell(tree, P, i * ny + j, qx, qy, qth, best, besti)
-                j += step
+        for q in range(_ring_cells(tree, ci, cj, k, cells)):
+            best, besti = _scan_cell(tree, P, cells[q], qx, qy, qth, best, besti)
     return besti, best
 
 
 @njit(cache=True)
-def _near(tree: Tree, x, y, radius) -> int:
-    """Fill tree.near / near_len with the nodes within Euclidean ``radius`` of (x, y).
+def _ring_cells(tree: Tree, ci, cj, k, out) -> int:
+    """Write the grid cells at Chebyshev distance k from (ci, cj) into ``out``; their count."""
+    nx, ny = int(tree.grid[3]), int(tree.grid[4])
+    n = 0
+    for i in range(ci - k, ci + k + 1):
+        if i < 0 or i >= nx:
+            continue
+        step = 2 * k if 0 < k and i != ci - k and i != ci + k else 1
+        j = cj - k
+        while j <= cj + k:
+            if 0 <= j < ny:
+                out[n] = i * ny + j
+                n += 1
+            j += step
+    return n
 
-    Car path lengths are never shorter than the Euclidean distance, so this ball holds every
-    node within steering length ``radius`` in either direction; exact lengths come later, and
-    only for candidates whose bound can still pay off.
+
+@njit(cache=True)
+def _collect_ring(tree: Tree, x, y, ci, cj, k, m, cells) -> int:
+    """Append the nodes of grid ring k around cell (ci, cj) to tree.near; returns the count."""
+    for q in range(_ring_cells(tree, ci, cj, k, cells)):
+        node = tree.cell_head[cells[q]]
+        while node >= 0:
+            tree.near[m] = node
+            tree.near_len[m] = math.hypot(tree.pose[node, 0] - x, tree.pose[node, 1] - y)
+            m += 1
+            node = tree.cell_next[node]
+    return m
+
+
+@njit(cache=True)
+def _near(tree: Tree, x, y, radius, k_nearest) -> int:
+    """Fill tree.near / near_len with the near candidates of (x, y), with Euclidean distances.
+
+    Radius form: every node within ``radius``. Car path lengths are never shorter than the
+    Euclidean distance, so this ball holds every node within steering length ``radius`` in
+    either direction; exact lengths come later, and only for candidates whose bound can still
+    pay off. k form (``k_nearest`` > 0): the k Euclidean-nearest nodes.
     """
     nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
     ci, cj = _cell(tree, x, y)
-    k = int(math.ceil(radius / cell))
     m = 0
-    for i in range(max(ci - k, 0), min(ci + k, nx - 1) + 1):
-        for j in range(max(cj - k, 0), min(cj + k, ny - 1) + 1):
+    if k_nearest > 0:
+        cells = np.empty(8 * (max(nx, ny) + 1), np.int64)
+        for k in range(max(nx, ny) + 1):
+            if m >= k_nearest:
+                kth = np.sort(tree.near_len[:m])[k_nearest - 1]
+                if (k - 1) * cell > kth:
+                    break
+            m = _collect_ring(tree, x, y, ci, cj, k, m, cells)
+        if m > k_nearest:
+            order = np.argsort(tree.near_len[:m])[:k_nearest]
+            nodes = tree.near[order]
+            dists = tree.near_len[order]
+            tree.near[:k_nearest] = nodes
+            tree.near_len[:k_nearest] = dists
+            m = k_nearest
+        return m
+    kr = int(math.ceil(radius / cell))
+    for i in range(max(ci - kr, 0), min(ci + kr, nx - 1) + 1):
+        for j in range(max(cj - kr, 0), min(cj + kr, ny - 1) + 1):
             node = tree.cell_head[i * ny + j]
             while node >= 0:
                 d = math.hypot(tree.pose[node, 0] - x, tree.pose[node, 1] - y)
@@ -407,8 +449,12 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
         radius = 0.0
         if P[STAR] > 0.0:
             n = tree.cnt[N] + 1.0
-            radius = min(P[GAMMA] * (math.log(n) / n) ** (1.0 / 3.0), P[EPS])
-            m = _near(tree, x, y, radius)
+            if P[K_RRT] > 0.0:
+                radius = math.inf
+                m = _near(tree, x, y, radius, int(math.ceil(P[K_RRT] * math.log(n))))
+            else:
+                radius = min(P[GAMMA] * (math.log(n) / n) ** (1.0 / 3.0), P[EPS])
+                m = _near(tree, x, y, radius, 0)
             c_new, parent = _choose_parent(tree, w, P, m, x, y, th, radius, c_new, parent,
                                            kinds, lens, scratch_k, scratch_l, counter)
         new = add_node(tree, P, x, y, th, c_new, parent, kinds, lens)

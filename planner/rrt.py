@@ -7,6 +7,7 @@ can be observed through listeners that receive the kernel's event records.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -34,6 +35,7 @@ class PlannerSettings:
     steering: str = "dubins"
     eps: float | None = None  # longest extension (m)
     gamma: float | None = None  # RRT* radius constant
+    k_rrt: float | None = None  # RRT* with k = k_rrt · log n nearest instead of a radius
     goal_bias: float = 0.05
     informed: bool | None = None  # default: on for RRT*
     seed: int = 0
@@ -44,7 +46,7 @@ class PlannerSettings:
             raise ValueError(f"unknown planner '{self.algorithm}' (use one of {ALGORITHMS})")
         if self.steering not in STEERINGS:
             raise ValueError(f"unknown steering '{self.steering}' (use one of {STEERINGS})")
-        for name in ("eps", "gamma", "speed"):
+        for name in ("eps", "gamma", "k_rrt", "speed"):
             v = getattr(self, name)
             if v is not None and not (math.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be a finite number > 0, got {v}")
@@ -64,8 +66,7 @@ class PlannerSettings:
             gamma = 1.1 * (2.0 * (4.0 / 3.0) * measure / (4.0 * math.pi / 3.0)) ** (1.0 / 3.0)
         informed = self.informed if self.informed is not None else self.algorithm == "rrtstar"
         speed = self.speed if self.speed is not None else problem.speed
-        return PlannerSettings(self.algorithm, self.steering, eps, gamma, self.goal_bias,
-                               informed, self.seed, speed)
+        return dataclasses.replace(self, eps=eps, gamma=gamma, informed=informed, speed=speed)
 
 
 @dataclass
@@ -152,6 +153,7 @@ class Planner:
         P[K.STAR] = float(s.algorithm == "rrtstar")
         P[K.REVERSE] = float(s.steering == "reeds-shepp")
         P[K.SX], P[K.SY] = problem.start[:2]
+        P[K.K_RRT] = s.k_rrt or 0.0
         self._P = P
         zero = np.zeros(5)
         K.add_node(self._tree, P, *problem.start, 0.0, -1, zero.astype(np.int8), zero)

@@ -109,3 +109,10 @@ def test_start_or_goal_in_collision_is_rejected(mutate, message):
     scn["obstacles"].append({"type": "circle", "center": [5.0, 5.0], "radius": 0.5})
     with pytest.raises(planner.ScenarioError, match=message):
         planner.compile_problem(planner.parse_scenario(scn))
+
+
+def test_k_nearest_variant_finds_valid_paths_and_rewires():
+    result = plan("slalom", iterations=3000, k_rrt=5.5)
+    assert result.solved and result.rewires > 0
+    assert first_collision(scenario_dict("slalom"), result.path[:, :3]) is None
+    assert result.settings.k_rrt == 5.5

@@ -35,6 +35,8 @@ def plan(
     seed: Annotated[int, typer.Option(help="Random seed: same seed, same tree.")] = 0,
     eps: Annotated[float | None, typer.Option(help="Longest extension ε (m).")] = None,
     gamma: Annotated[float | None, typer.Option(help="RRT* radius constant γ.")] = None,
+    k_rrt: Annotated[float | None, typer.Option(help="RRT* with the k = k_rrt·log n nearest "
+                                                     "instead of a radius (OMPL: 5.5).")] = None,
     goal_bias: Annotated[float, typer.Option(help="Probability of sampling the goal.")] = 0.05,
     informed: Annotated[bool | None, typer.Option(help="Informed sampling after the first "
                                                        "solution [default: on for RRT*].")] = None,
@@ -53,7 +55,7 @@ def plan(
         problem = core.compile_problem(core.load_scenario(scenario))
         settings = core.PlannerSettings(
             algorithm=planner.value, steering=steering.value, eps=eps, gamma=gamma,
-            goal_bias=goal_bias, informed=informed, seed=seed, speed=speed)
+            k_rrt=k_rrt, goal_bias=goal_bias, informed=informed, seed=seed, speed=speed)
         result = core.Planner(problem, settings).solve(budget_time, iterations)
     report = plan_report(result, problem.scenario.name,
                          {"time": budget_time, "iterations": iterations})
