@@ -439,12 +439,19 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
             ev.rows[row, EV_YR] = yr
             ev.rows[row, EV_THR] = thr
             ev.rows[row, EV_NEAREST] = near_i
-        tree.cnt[CHECKS] += 1
-        if dist <= 0.0 or not motion_free(w, nx0, ny0, nth0, tree.cost[near_i] / P[SPEED],
-                                          kinds, lens, P[RHO], P[SPEED], counter):
+        if dist <= 0.0:
             continue
+        tree.cnt[CHECKS] += 1
         parent = near_i
         c_new = tree.cost[near_i] + dist
+        if not motion_free(w, nx0, ny0, nth0, tree.cost[near_i] / P[SPEED], kinds, lens,
+                           P[RHO], P[SPEED], counter):
+            if P[STAR] == 0.0:
+                continue
+            # RRT*: another near node may still reach x_new (with moving obstacles often one
+            # that arrives later, when the way is clear).
+            parent = -1
+            c_new = math.inf
         m = 0
         radius = 0.0
         if P[STAR] > 0.0:
@@ -457,6 +464,8 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
                 m = _near(tree, x, y, radius, 0)
             c_new, parent = _choose_parent(tree, w, P, m, x, y, th, radius, c_new, parent,
                                            kinds, lens, scratch_k, scratch_l, counter)
+            if parent < 0:
+                continue
         new = add_node(tree, P, x, y, th, c_new, parent, kinds, lens)
         changed = tree.cnt[NGOAL] > 0 and tree.goal_nodes[tree.cnt[NGOAL] - 1] == new
         if record:
