@@ -24,7 +24,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-SCENARIO_DIR = Path("/work/shared/scenarios")
+SCENARIO_DIR = Path(__file__).resolve().parents[2] / "shared" / "scenarios"
 STATIC_SCENARIOS = ["open_field", "hallway", "slalom", "parking", "oval_track"]
 OMPL_PLANNERS = ["RRTstar", "InformedRRTstar", "BITstar"]
 OURS = "ours"

@@ -16,7 +16,7 @@ def plan(name, iterations=3000, **kw):
 
 
 @pytest.mark.parametrize("name", STATIC)
-@pytest.mark.parametrize("steering", ["dubins"])
+@pytest.mark.parametrize("steering", ["dubins", "reeds-shepp"])
 def test_paths_are_valid_continuous_and_feasible(name, steering):
     result = plan(name, iterations=4000, steering=steering)
     assert result.solved, f"{name} not solved in 4000 iterations"
@@ -35,6 +35,14 @@ def test_paths_are_valid_continuous_and_feasible(name, steering):
     steps = np.hypot(*np.diff(path[:, :2], axis=0).T)
     assert result.cost == pytest.approx(steps.sum(), rel=2e-3)
     assert result.min_clearance_m > 0
+
+
+def test_reeds_shepp_reverses_into_the_parking_slot_and_is_never_longer():
+    dub = plan("parking", iterations=6000, steering="dubins")
+    rs = plan("parking", iterations=6000, steering="reeds-shepp")
+    assert rs.solved and dub.solved
+    assert np.any(rs.path[:, 4] < 0), "Reeds-Shepp should use reverse somewhere"
+    assert np.all(dub.path[:, 4] > 0)
 
 
 def test_same_seed_same_tree_other_seed_other_tree():
