@@ -13,13 +13,19 @@ from tracks._track import Track
 FORMATS = (".png", ".svg", ".pdf")
 
 
+def figure_path(output: str | Path) -> Path:
+    """``output`` as a Path if matplotlib can write its format, else a TrackError."""
+    output = Path(output)
+    if output.suffix.lower() not in FORMATS:
+        raise TrackError(f"output must end in {', '.join(FORMATS)}, got {output.name!r}")
+    return output
+
+
 def plot_profile(track: Track, profile: Profile, output: str | Path, max_steer_deg: float) -> Path:
     """Write the track with its boundaries, and curvature and steering angle over s (±δmax shaded)."""
     from matplotlib.figure import Figure
 
-    output = Path(output)
-    if output.suffix.lower() not in FORMATS:
-        raise TrackError(f"output must end in {', '.join(FORMATS)}, got {output.name!r}")
+    output = figure_path(output)
     spacing = profile.s[1] - profile.s[0] if len(profile.s) > 1 else 0.02
     left, right = track.boundaries(spacing)
     bad = ~profile.feasible

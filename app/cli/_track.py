@@ -114,8 +114,9 @@ def plot(
 ) -> None:
     """Draw the track with its boundaries, and curvature and steering angle over s."""
     with user_errors():
-        from tracks._plot import plot_profile
+        from tracks._plot import figure_path, plot_profile
 
+        figure_path(output)
         track = _load(file, path, unit)
         written = plot_profile(track, track.sample(spacing, wheelbase, max_steer_deg), output, max_steer_deg)
     print(written)
