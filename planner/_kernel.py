@@ -160,19 +160,6 @@ def _sample(tree: Tree, w: World, P: np.ndarray):
     return x, y, th
 
 
-@njit(cache=True)
-def _scan_cell(tree: Tree, P, c, qx, qy, qth, best, besti):
-    node = tree.cell_head[c]
-    while node >= 0:
-        if _lower_bound(tree, P, node, qx, qy, qth, best) < best:
-            d = steer_length(P[REVERSE], tree.pose[node, 0], tree.pose[node, 1],
-                             tree.pose[node, 2], qx, qy, qth, P[RHO], best)
-            if d < best:
-                best, besti = d, node
-        node = tree.cell_next[node]
-    return best, besti
-
-
 @njit(cache=True, inline="always")
 def _lower_bound(tree: Tree, P, node, qx, qy, qth, best) -> float:
     """A cheap lower bound of the car path length from a node to a pose, tightened in steps
@@ -193,27 +180,81 @@ def _lower_bound(tree: Tree, P, node, qx, qy, qth, best) -> float:
     return max(a, dubins_to_point(qx, qy, qth + math.pi, x, y, P[RHO]))
 
 
+@njit(cache=True, inline="always")
+def _heap_push(keys, vals, size, key, val) -> int:
+    i = size
+    keys[i] = key
+    vals[i] = val
+    while i > 0:
+        up = (i - 1) >> 1
+        if keys[up] <= keys[i]:
+            break
+        keys[up], keys[i] = keys[i], keys[up]
+        vals[up], vals[i] = vals[i], vals[up]
+        i = up
+    return size + 1
+
+
+@njit(cache=True, inline="always")
+def _heap_pop(keys, vals, size) -> int:
+    """Remove the smallest entry (the caller has read keys[0], vals[0]); returns the new size."""
+    size -= 1
+    keys[0] = keys[size]
+    vals[0] = vals[size]
+    i = 0
+    while True:
+        c = 2 * i + 1
+        if c >= size:
+            break
+        if c + 1 < size and keys[c + 1] < keys[c]:
+            c += 1
+        if keys[i] <= keys[c]:
+            break
+        keys[c], keys[i] = keys[i], keys[c]
+        vals[c], vals[i] = vals[i], vals[c]
+        i = c
+    return size
+
+
 @njit(cache=True)
 def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
-    """(node, steering length) of the tree node with the shortest car path to the query pose."""
-    n = tree.cnt[N]
-    best, besti = math.inf, -1
-    if n <= 32:
-        for node in range(n):
-            if _lower_bound(tree, P, node, qx, qy, qth, best) < best:
-                d = steer_length(P[REVERSE], tree.pose[node, 0], tree.pose[node, 1],
-                                 tree.pose[node, 2], qx, qy, qth, P[RHO], best)
-                if d < best:
-                    best, besti = d, node
-        return besti, best
+    """(node, steering length) of the tree node with the shortest car path to the query pose.
+
+    Best first: grid rings are opened outward, their nodes enter a min-heap keyed by a lower
+    bound of their path length, and exact lengths are computed in increasing bound order, so
+    the first ones are usually near-optimal and the search stops when neither the heap's top
+    nor the next ring's distance can beat the best length found.
+    """
     nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
     ci, cj = _cell(tree, qx, qy)
     cells = np.empty(8 * (max(nx, ny) + 1), np.int64)
-    for k in range(max(nx, ny) + 1):
-        if k >= 2 and (k - 1) * cell > best:
+    keys, vals = tree.near_key, tree.stack  # scratch: free until choose-parent
+    size = 0
+    best, besti = math.inf, -1
+    k = 0
+    last_ring = max(nx, ny)
+    while True:
+        ring_bound = max(0.0, (k - 1) * cell) if k <= last_ring else math.inf
+        if size > 0 and keys[0] <= ring_bound:
+            key, node = keys[0], vals[0]
+            if key >= best:
+                break  # every remaining candidate, opened or not, is at least this far
+            size = _heap_pop(keys, vals, size)
+            d = steer_length(P[REVERSE], tree.pose[node, 0], tree.pose[node, 1],
+                             tree.pose[node, 2], qx, qy, qth, P[RHO], best)
+            if d < best:
+                best, besti = d, node
+        elif ring_bound >= best:
             break
-        for q in range(_ring_cells(tree, ci, cj, k, cells)):
-            best, besti = _scan_cell(tree, P, cells[q], qx, qy, qth, best, besti)
+        else:
+            for q in range(_ring_cells(tree, ci, cj, k, cells)):
+                node = tree.cell_head[cells[q]]
+                while node >= 0:
+                    lb = _lower_bound(tree, P, node, qx, qy, qth, best)
+                    if lb < best:
+                        size = _heap_push(keys, vals, size, lb, node)
+                    node = tree.cell_next[node]
+            k += 1
     return besti, best
 
 
@@ -249,6 +290,18 @@ def _collect_ring(tree: Tree, x, y, ci, cj, k, m, cells) -> int:
 
 
 @njit(cache=True)
+def _select_smallest(tree: Tree, m: int, k: int) -> None:
+    """Move the k smallest of near_len[:m] (with their nodes) to the front, in order."""
+    for a in range(k):
+        low = a
+        for b in range(a + 1, m):
+            if tree.near_len[b] < tree.near_len[low]:
+                low = b
+        tree.near_len[a], tree.near_len[low] = tree.near_len[low], tree.near_len[a]
+        tree.near[a], tree.near[low] = tree.near[low], tree.near[a]
+
+
+@njit(cache=True)
 def _near(tree: Tree, x, y, radius, k_nearest) -> int:
     """Fill tree.near / near_len with the near candidates of (x, y), with Euclidean distances.
 
@@ -264,16 +317,12 @@ def _near(tree: Tree, x, y, radius, k_nearest) -> int:
         cells = np.empty(8 * (max(nx, ny) + 1), np.int64)
         for k in range(max(nx, ny) + 1):
             if m >= k_nearest:
-                kth = np.sort(tree.near_len[:m])[k_nearest - 1]
-                if (k - 1) * cell > kth:
+                _select_smallest(tree, m, k_nearest)
+                if (k - 1) * cell > tree.near_len[k_nearest - 1]:
                     break
             m = _collect_ring(tree, x, y, ci, cj, k, m, cells)
         if m > k_nearest:
-            order = np.argsort(tree.near_len[:m])[:k_nearest]
-            nodes = tree.near[order]
-            dists = tree.near_len[order]
-            tree.near[:k_nearest] = nodes
-            tree.near_len[:k_nearest] = dists
+            _select_smallest(tree, m, k_nearest)
             m = k_nearest
         return m
     kr = int(math.ceil(radius / cell))

@@ -8,7 +8,7 @@ from planner._dubins import dubins_length, dubins_path
 from planner._reeds_shepp import reeds_shepp_length, reeds_shepp_path
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def steer_path(reverse, x0, y0, th0, x1, y1, th1, rho, kinds, lens) -> float:
     """Shortest local path between two poses, written into kinds/lens; returns its length."""
     if reverse > 0.0:
@@ -16,7 +16,7 @@ def steer_path(reverse, x0, y0, th0, x1, y1, th1, rho, kinds, lens) -> float:
     return dubins_path(x0, y0, th0, x1, y1, th1, rho, kinds, lens)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def steer_length(reverse, x0, y0, th0, x1, y1, th1, rho, bound) -> float:
     """Length of the shortest local path; any value ≥ ``bound`` once it cannot beat it."""
     if reverse > 0.0:

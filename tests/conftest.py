@@ -16,6 +16,15 @@ def scenario_dict(name: str) -> dict:
     return json.loads((SCENARIOS / f"{name}.json").read_text())
 
 
+@pytest.fixture(scope="session", autouse=True)
+def compiled_planner():
+    """Compile the planner's kernels once, in this process, into numba's on-disk cache, so the
+    CLI subprocesses the tests start load them in about a second."""
+    from planner.rrt import warm_up
+
+    warm_up()
+
+
 @pytest.fixture
 def scenarios_dir() -> Path:
     assert SCENARIOS.is_dir(), f"reference scenarios not found at {SCENARIOS}"
