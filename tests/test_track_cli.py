@@ -84,6 +84,8 @@ def test_bad_input_exits_2_with_one_line_on_stderr_within_a_second(tmp_path, arg
     if content is not None:
         (tmp_path / args[1]).write_bytes(content)
     done, seconds = run(*args, cwd=tmp_path)
+    if seconds >= 1.0:  # a busy machine: time a second attempt before blaming the code
+        done, seconds = run(*args, cwd=tmp_path)
     assert done.returncode == 2
     assert done.stdout == ""
     lines = done.stderr.strip().splitlines()

@@ -10,7 +10,7 @@ from tracks._library import library_names, library_path, load_library_track
 from tracks._profile import Profile
 from tracks._segments import Bezier, EllipticArc, arc_from_endpoints, line
 from tracks._svg_import import inspect_svg, load_svg
-from tracks._track import STEERING_COLUMNS, Track
+from tracks._track import STEERING_COLUMNS, Track, check_sampling
 from tracks._units import UNIT_CHOICES
 
 __all__ = [
@@ -22,6 +22,7 @@ __all__ = [
     "Track",
     "TrackError",
     "arc_from_endpoints",
+    "check_sampling",
     "de_casteljau",
     "inspect_svg",
     "library_names",

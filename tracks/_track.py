@@ -22,6 +22,13 @@ def _positive(name: str, value: float) -> float:
     return float(value)
 
 
+def check_sampling(spacing: float, wheelbase: float, max_steer_deg: float) -> tuple[float, float, float]:
+    """The sampling parameters, validated: positive spacing and wheelbase, 0 < δmax < 90°."""
+    if not (isinstance(max_steer_deg, int | float) and 0 < max_steer_deg < 90):
+        raise TrackError(f"max steering angle must be in (0, 90) degrees, got {max_steer_deg!r}")
+    return _positive("spacing", spacing), _positive("wheelbase", wheelbase), float(max_steer_deg)
+
+
 @dataclass(frozen=True, eq=False)
 class Track:
     """Centreline segments in metres, world frame; built by `load_svg` or from segments.
@@ -74,9 +81,7 @@ class Track:
         self, spacing: float = 0.02, wheelbase: float = 0.44, max_steer_deg: float = 26.0
     ) -> Profile:
         """Target points every ``spacing`` metres with heading, curvature and steering angle."""
-        key = (_positive("spacing", spacing), _positive("wheelbase", wheelbase), max_steer_deg)
-        if not 0 < max_steer_deg < 90:
-            raise TrackError(f"max steering angle must be in (0, 90) degrees, got {max_steer_deg}")
+        key = check_sampling(spacing, wheelbase, max_steer_deg)
         if key not in self._profiles:
             self._profiles[key] = driving_profile(
                 self.chain,

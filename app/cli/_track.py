@@ -86,6 +86,9 @@ def sample(
             from app.cli._errors import InputError
 
             raise InputError("choose one of --json and --csv")
+        from tracks import check_sampling
+
+        check_sampling(spacing, wheelbase, max_steer_deg)
         profile = _load(file, path, unit).sample(spacing, wheelbase, max_steer_deg)
     if as_json:
         print(json.dumps(profile.to_dict()))
@@ -114,9 +117,11 @@ def plot(
 ) -> None:
     """Draw the track with its boundaries, and curvature and steering angle over s."""
     with user_errors():
+        from tracks import check_sampling
         from tracks._plot import figure_path, plot_profile
 
         figure_path(output)
+        check_sampling(spacing, wheelbase, max_steer_deg)
         track = _load(file, path, unit)
         written = plot_profile(track, track.sample(spacing, wheelbase, max_steer_deg), output, max_steer_deg)
     print(written)
