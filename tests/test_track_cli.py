@@ -14,7 +14,14 @@ DATA = Path(__file__).parent / "data"
 
 def run(*args, cwd=None):
     started = time.perf_counter()
-    done = subprocess.run(["trackstar", "track", *args], capture_output=True, text=True, cwd=cwd, timeout=60)
+    done = subprocess.run(
+        ["trackstar", "track", *args],
+        capture_output=True,
+        text=True,
+        check=False,
+        cwd=cwd,
+        timeout=60,
+    )
     return done, time.perf_counter() - started
 
 
@@ -49,8 +56,17 @@ def test_sample_json_starts_at_the_start_and_ends_at_the_end():
 
 def test_sample_csv_with_path_wheelbase_and_steering_limit(tmp_path):
     done, _ = run(
-        "sample", str(DATA / "nested_mm.svg"), "--path", "centre", "--csv",
-        "--spacing", "0.001", "--wheelbase", "0.02", "--max-steer-deg", "30",
+        "sample",
+        str(DATA / "nested_mm.svg"),
+        "--path",
+        "centre",
+        "--csv",
+        "--spacing",
+        "0.001",
+        "--wheelbase",
+        "0.02",
+        "--max-steer-deg",
+        "30",
     )
     assert done.returncode == 0, done.stderr
     rows = list(csv.DictReader(io.StringIO(done.stdout)))
@@ -72,12 +88,24 @@ def test_plot_writes_a_figure(tmp_path):
         (["inspect", "missing.svg"], None),
         (["sample", "bad.svg"], b"this is not xml"),
         (["sample", "page.svg"], b"<html><p>hello</p></html>"),
-        (["inspect", "bomb.svg"], b'<?xml version="1.0"?><!DOCTYPE s [<!ENTITY a "aaaaaaaaaa">'
-         b'<!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;"><!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;">]>'
-         b'<svg xmlns="http://www.w3.org/2000/svg"><text>&c;</text></svg>'),
-        (["sample", "ok.svg", "--path", "nope"], b'<svg xmlns="http://www.w3.org/2000/svg"><path id="p" d="M0 0H9"/></svg>'),
-        (["plot", "ok.svg", "-o", "figure.txt"], b'<svg xmlns="http://www.w3.org/2000/svg"><path d="M0 0H9"/></svg>'),
-        (["sample", "ok.svg", "--spacing", "-1"], b'<svg xmlns="http://www.w3.org/2000/svg"><path d="M0 0H9"/></svg>'),
+        (
+            ["inspect", "bomb.svg"],
+            b'<?xml version="1.0"?><!DOCTYPE s [<!ENTITY a "aaaaaaaaaa">'
+            b'<!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;"><!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;">]>'
+            b'<svg xmlns="http://www.w3.org/2000/svg"><text>&c;</text></svg>',
+        ),
+        (
+            ["sample", "ok.svg", "--path", "nope"],
+            b'<svg xmlns="http://www.w3.org/2000/svg"><path id="p" d="M0 0H9"/></svg>',
+        ),
+        (
+            ["plot", "ok.svg", "-o", "figure.txt"],
+            b'<svg xmlns="http://www.w3.org/2000/svg"><path d="M0 0H9"/></svg>',
+        ),
+        (
+            ["sample", "ok.svg", "--spacing", "-1"],
+            b'<svg xmlns="http://www.w3.org/2000/svg"><path d="M0 0H9"/></svg>',
+        ),
     ],
 )
 def test_bad_input_exits_2_with_one_line_on_stderr_within_a_second(tmp_path, args, content):

@@ -112,7 +112,11 @@ def test_default_spacing_is_two_centimetres_to_a_micrometre_on_a_drivable_track(
         [Bezier(np.array([[0, 0], [2, 1], [0, 1], [2, 0.0]]))],  # a cusp inside
         [Bezier(np.array([[0, 0], [1, 0], [2, 0], [3, 0.0]])), line([3, 0], [3, 0])],  # zero length
         [Bezier(np.array([[0, 0], [3, 0], [1, 0], [2, 0.0]]))],  # straight, reversing
-        [line([0, 0], [1, 0]), Bezier(np.array([[1, 0], [1, 0], [1, 0], [1, 0.0]])), line([1, 0], [1, 1])],
+        [
+            line([0, 0], [1, 0]),
+            Bezier(np.array([[1, 0], [1, 0], [1, 0], [1, 0.0]])),
+            line([1, 0], [1, 1]),
+        ],
     ],
 )
 def test_degenerate_segments_give_finite_profiles(segments):

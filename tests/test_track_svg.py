@@ -57,8 +57,15 @@ def test_nested_transformed_groups_and_arcs_land_where_the_matrices_say():
     local_len = 20 + 5 * math.pi + 5
     assert track.length_m == pytest.approx(2 * local_len * MM, rel=1e-12)
     s = np.array([0, 20, 20 + 2.5 * math.pi, 20 + 5 * math.pi, local_len]) * 2 * MM
-    local = np.array([[0, 0], [20, 0], [20 + 10 * math.cos(-math.pi / 4), 10 + 10 * math.sin(-math.pi / 4)],
-                      [30, 10], [30, 15]])
+    local = np.array(
+        [
+            [0, 0],
+            [20, 0],
+            [20 + 10 * math.cos(-math.pi / 4), 10 + 10 * math.sin(-math.pi / 4)],
+            [30, 10],
+            [30, 15],
+        ]
+    )
     assert np.allclose(track.points_at(s), world(m, local), atol=1e-12)
     assert track.width_m == pytest.approx(4 * 2 * MM)  # inherited stroke width, scaled by 2
     assert not track.closed
@@ -90,7 +97,9 @@ def test_svgpathtools_transform_flips_the_sweep_by_the_wrong_test():
     theirs = transform(arc, swap).point(0.5)
     p = arc.point(0.5)
     assert abs(theirs - complex(p.imag, p.real)) > 1  # their arc bulges the other way
-    ours = arc_from_endpoints([20, 0], [30, 10], (10, 10), 0, False, True).transformed(swap[:2, :2], np.zeros(2))
+    ours = arc_from_endpoints([20, 0], [30, 10], (10, 10), 0, False, True).transformed(
+        swap[:2, :2], np.zeros(2)
+    )
     assert np.allclose(ours.point(np.array([0.5])), [[p.imag, p.real]], atol=1e-12)
 
 
@@ -114,7 +123,9 @@ def test_document_order_layers_hidden_elements_clones_and_shapes():
 def test_skewed_clone_with_x_y_offset_maps_its_end_points():
     track = load_svg(DATA / "nested_mm.svg", path_id="skewed")
     skew = np.array([[1, math.tan(math.radians(15)), 0], [0, 1, 0], [0, 0, 1.0]])
-    assert np.allclose(ends(track), world(skew @ T(30, 40), np.array([[0, 0], [20, 20]])), atol=1e-12)
+    assert np.allclose(
+        ends(track), world(skew @ T(30, 40), np.array([[0, 0], [20, 20]])), atol=1e-12
+    )
 
 
 # ---- units ----------------------------------------------------------------------------------
@@ -228,11 +239,21 @@ def test_a_missing_file_is_a_track_error():
 
 items = st.one_of(
     st.tuples(st.just("translate"), st.tuples(st.floats(-50, 50), st.floats(-50, 50))),
-    st.tuples(st.just("scale"), st.tuples(st.sampled_from([-2, -1, -0.5, 0.5, 1, 3]), st.sampled_from([-1, 0.25, 1, 2]))),
-    st.tuples(st.just("rotate"), st.tuples(st.floats(-180, 180), st.floats(-20, 20), st.floats(-20, 20))),
+    st.tuples(
+        st.just("scale"),
+        st.tuples(st.sampled_from([-2, -1, -0.5, 0.5, 1, 3]), st.sampled_from([-1, 0.25, 1, 2])),
+    ),
+    st.tuples(
+        st.just("rotate"), st.tuples(st.floats(-180, 180), st.floats(-20, 20), st.floats(-20, 20))
+    ),
     st.tuples(st.just("skewX"), st.tuples(st.floats(-40, 40))),
     st.tuples(st.just("skewY"), st.tuples(st.floats(-40, 40))),
-    st.tuples(st.just("matrix"), st.tuples(*[st.floats(-2, 2)] * 2, *[st.floats(-2, 2)] * 2, st.floats(-9, 9), st.floats(-9, 9))),
+    st.tuples(
+        st.just("matrix"),
+        st.tuples(
+            *[st.floats(-2, 2)] * 2, *[st.floats(-2, 2)] * 2, st.floats(-9, 9), st.floats(-9, 9)
+        ),
+    ),
 )
 
 
@@ -265,7 +286,9 @@ def test_nested_transforms_compose_like_hand_built_matrices_reflections_included
     track = load_svg(svg(body))
     local_mid = [12 + 5 * math.cos(-math.pi / 4), 6 + 5 * math.sin(-math.pi / 4)]
     expected = world(matrix, np.array([[2, 1], [12, 1], local_mid, [17, 6]]))
-    got = np.vstack([ends(track)[:1], track.segments[0].end, track.segments[1].point(np.array([0.5, 1.0]))])
+    got = np.vstack(
+        [ends(track)[:1], track.segments[0].end, track.segments[1].point(np.array([0.5, 1.0]))]
+    )
     assert np.allclose(got, expected, atol=1e-12)
 
 
@@ -282,13 +305,23 @@ def chained(pieces):
 pt = st.tuples(st.floats(-3, 3), st.floats(-3, 3)).map(np.array)
 bezier = st.lists(pt, min_size=2, max_size=4).map(lambda ps: Bezier(np.array(ps)))
 arc = st.builds(
-    lambda p, r1, r2, rot, large, sweep: arc_from_endpoints(np.zeros(2), p, (r1, r2), rot, large, sweep),
-    pt, st.floats(0.3, 4), st.floats(0.3, 4), st.floats(-90, 90), st.booleans(), st.booleans(),
+    lambda p, r1, r2, rot, large, sweep: arc_from_endpoints(
+        np.zeros(2), p, (r1, r2), rot, large, sweep
+    ),
+    pt,
+    st.floats(0.3, 4),
+    st.floats(0.3, 4),
+    st.floats(-90, 90),
+    st.booleans(),
+    st.booleans(),
 )
 
 
 @settings(max_examples=25, deadline=None)
-@given(st.lists(st.one_of(bezier, arc).filter(lambda s: s is not None), min_size=1, max_size=5), st.floats(0.05, 2))
+@given(
+    st.lists(st.one_of(bezier, arc).filter(lambda s: s is not None), min_size=1, max_size=5),
+    st.floats(0.05, 2),
+)
 def test_export_then_import_gives_the_same_geometry(pieces, width):
     segments = chained(pieces)
     try:
@@ -305,8 +338,12 @@ def test_export_then_import_gives_the_same_geometry(pieces, width):
 
 
 def test_a_loop_exports_as_a_closed_inkscape_path():
-    circle = chained([arc_from_endpoints([0, 0], [2, 0], (1, 1), 0, False, True),
-                      arc_from_endpoints([2, 0], [0, 0], (1, 1), 0, False, True)])
+    circle = chained(
+        [
+            arc_from_endpoints([0, 0], [2, 0], (1, 1), 0, False, True),
+            arc_from_endpoints([2, 0], [0, 0], (1, 1), 0, False, True),
+        ]
+    )
     track = Track(name="ring", closed=True, width_m=0.4, segments=circle)
     text = track.to_svg()
     assert 'inkscape:groupmode="layer"' in text and 'id="ring"' in text and "Z" in text
@@ -317,5 +354,7 @@ def test_a_loop_exports_as_a_closed_inkscape_path():
 
 
 def test_line_helper_and_zero_length_closing_segment_are_dropped():
-    track = Track(name="x", closed=False, width_m=1, segments=(line([0, 0], [1, 0]), line([1, 0], [1, 0])))
+    track = Track(
+        name="x", closed=False, width_m=1, segments=(line([0, 0], [1, 0]), line([1, 0], [1, 0]))
+    )
     assert len(track.segments) == 1

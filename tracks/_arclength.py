@@ -56,7 +56,7 @@ def length_table(velocity: Velocity, count: int, rtol: float = 1e-12) -> LengthT
     """Adaptive quadrature over [0, 1] of ``count`` segments, to ``rtol`` of the total length."""
     idx, a, b = np.arange(count), np.zeros(count), np.ones(count)
     whole = _gauss(velocity, idx, a, b)
-    done_len = float(0.0)
+    done_len = 0.0
     accepted = []
     for depth in range(_MAX_DEPTH + 1):
         total = done_len + whole.sum()
@@ -102,7 +102,9 @@ def _first_guess(table: LengthTable, k: np.ndarray, target: np.ndarray) -> np.nd
     return np.clip(t, a, b)
 
 
-def params_at(velocity: Velocity, table: LengthTable, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def params_at(
+    velocity: Velocity, table: LengthTable, s: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """(segment index, t) at arc lengths ``s`` along the path: safeguarded Newton.
 
     Newton's step is (s(t) − s)/|B'(t)| inside the table interval holding s; where the speed

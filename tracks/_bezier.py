@@ -30,9 +30,13 @@ def de_casteljau(ctrl: np.ndarray, t: np.ndarray) -> np.ndarray:
 def elevate_to_cubic(ctrl: np.ndarray) -> np.ndarray:
     """The same curve, same parametrisation, as a cubic: lines and quadratics raised exactly."""
     if len(ctrl) == 2:
-        return np.array([ctrl[0], (2 * ctrl[0] + ctrl[1]) / 3, (ctrl[0] + 2 * ctrl[1]) / 3, ctrl[1]])
+        return np.array(
+            [ctrl[0], (2 * ctrl[0] + ctrl[1]) / 3, (ctrl[0] + 2 * ctrl[1]) / 3, ctrl[1]]
+        )
     if len(ctrl) == 3:
-        return np.array([ctrl[0], (ctrl[0] + 2 * ctrl[1]) / 3, (2 * ctrl[1] + ctrl[2]) / 3, ctrl[2]])
+        return np.array(
+            [ctrl[0], (ctrl[0] + 2 * ctrl[1]) / 3, (2 * ctrl[1] + ctrl[2]) / 3, ctrl[2]]
+        )
     return np.asarray(ctrl, dtype=float)
 
 

@@ -34,9 +34,16 @@ def plot_profile(track: Track, profile: Profile, output: str | Path, max_steer_d
     plan.plot(*left.T, color="0.45", lw=0.8, label="boundaries")
     plan.plot(*right.T, color="0.45", lw=0.8)
     plan.plot(profile.x, profile.y, color="C0", lw=1.2, label="centreline")
-    plan.plot(profile.x[bad], profile.y[bad], "o", color="C3", ms=2, label=f"|δ| > {max_steer_deg}°")
+    plan.plot(
+        profile.x[bad], profile.y[bad], "o", color="C3", ms=2, label=f"|δ| > {max_steer_deg}°"
+    )
     plan.plot(profile.x[0], profile.y[0], ">", color="C2", ms=9, label="start")
-    plan.set(aspect="equal", xlabel="x [m]", ylabel="y [m]", title=f"{track.name}: {track.length_m:.3f} m")
+    plan.set(
+        aspect="equal",
+        xlabel="x [m]",
+        ylabel="y [m]",
+        title=f"{track.name}: {track.length_m:.3f} m",
+    )
     plan.legend(loc="best", fontsize="small")
     curv.plot(profile.s, profile.curvature, color="C0")
     curv.set(ylabel="curvature κ [1/m]")

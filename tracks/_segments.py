@@ -70,7 +70,9 @@ class EllipticArc:
         return self.center + ellipse_point(self.axes, self.theta0 + np.asarray(t) * self.dtheta)
 
     def transformed(self, matrix: np.ndarray, offset: np.ndarray) -> EllipticArc:
-        return EllipticArc(matrix @ self.center + offset, matrix @ self.axes, self.theta0, self.dtheta)
+        return EllipticArc(
+            matrix @ self.center + offset, matrix @ self.axes, self.theta0, self.dtheta
+        )
 
     def extremum_params(self) -> np.ndarray:
         """Parameters in (0, 1) where x or y is extreme: θ = atan2(A[i,1], A[i,0]) + kπ."""

@@ -74,7 +74,9 @@ def parse_document(source: Source) -> ET.Element:
 
 def _style(elem: ET.Element) -> dict[str, str]:
     """Presentation attributes overridden by the style attribute's declarations."""
-    props = {k: elem.attrib[k] for k in ("display", "visibility", "stroke-width") if k in elem.attrib}
+    props = {
+        k: elem.attrib[k] for k in ("display", "visibility", "stroke-width") if k in elem.attrib
+    }
     for decl in elem.attrib.get("style", "").split(";"):
         key, sep, value = decl.partition(":")
         if sep:
@@ -96,7 +98,7 @@ class _Walker:
     def walk(self, elem, matrix, inherited, clone=None, uses=()) -> None:
         if not elem.tag.startswith(SVG):
             return
-        tag = elem.tag[len(SVG):]
+        tag = elem.tag[len(SVG) :]
         props = {**inherited, **_style(elem)}
         if props.get("display") == "none":
             return
@@ -152,16 +154,26 @@ def _segments(elem: _Element) -> list[list[Segment]]:
     try:
         parsed = parse_path(elem.path_data)
     except (ValueError, IndexError, AssertionError, ZeroDivisionError) as exc:
-        raise TrackError(f"element {elem.id!r}: bad path data: {exc or type(exc).__name__}") from None
+        raise TrackError(
+            f"element {elem.id!r}: bad path data: {exc or type(exc).__name__}"
+        ) from None
     subpaths: list[list[Segment]] = []
     previous_end = None
     for seg in parsed:
-        start, end = np.array([seg.start.real, seg.start.imag]), np.array([seg.end.real, seg.end.imag])
+        start, end = (
+            np.array([seg.start.real, seg.start.imag]),
+            np.array([seg.end.real, seg.end.imag]),
+        )
         if isinstance(seg, Line):
             ours = line(start, end)
         elif isinstance(seg, Arc):
             ours = arc_from_endpoints(
-                start, end, (seg.radius.real, seg.radius.imag), seg.rotation, seg.large_arc, seg.sweep
+                start,
+                end,
+                (seg.radius.real, seg.radius.imag),
+                seg.rotation,
+                seg.large_arc,
+                seg.sweep,
             )
         else:
             ours = Bezier(np.array([[p.real, p.imag] for p in seg.bpoints()]))
@@ -186,7 +198,9 @@ def element_track(elem: _Element, unit_m: float) -> Track | None:
         if not segs:
             continue
         gap = np.hypot(*(segs[-1].end - segs[0].start))
-        extent = max(np.ptp(np.array([s.start for s in segs] + [segs[-1].end]), axis=0).max(), 1e-300)
+        extent = max(
+            np.ptp(np.array([s.start for s in segs] + [segs[-1].end]), axis=0).max(), 1e-300
+        )
         try:
             track = Track(
                 name=elem.id or elem.label or "track",
@@ -235,7 +249,9 @@ def load_svg(
             raise TrackError("the document has no path of positive length")
         track = max(tracks, key=lambda t: t.length_m)
     if width_m is not None:
-        track = Track(name=track.name, closed=track.closed, width_m=width_m, segments=track.segments)
+        track = Track(
+            name=track.name, closed=track.closed, width_m=width_m, segments=track.segments
+        )
     return track
 
 

@@ -8,9 +8,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tracks._arclength import LengthTable, length_table, params_at
+from tracks._chain import Chain
 from tracks._errors import TrackError
 from tracks._profile import Profile, driving_profile
-from tracks._chain import Chain
 from tracks._segments import Segment
 
 STEERING_COLUMNS = ("s", "x", "y", "heading", "steering_deg")
@@ -22,7 +22,9 @@ def _positive(name: str, value: float) -> float:
     return float(value)
 
 
-def check_sampling(spacing: float, wheelbase: float, max_steer_deg: float) -> tuple[float, float, float]:
+def check_sampling(
+    spacing: float, wheelbase: float, max_steer_deg: float
+) -> tuple[float, float, float]:
     """The sampling parameters, validated: positive spacing and wheelbase, 0 < δmax < 90°."""
     if not (isinstance(max_steer_deg, int | float) and 0 < max_steer_deg < 90):
         raise TrackError(f"max steering angle must be in (0, 90) degrees, got {max_steer_deg!r}")
@@ -54,7 +56,9 @@ class Track:
         if not keep.any():
             raise TrackError(f"track {self.name!r} has zero length")
         if not keep.all():
-            object.__setattr__(self, "segments", tuple(np.asarray(self.segments, dtype=object)[keep]))
+            object.__setattr__(
+                self, "segments", tuple(np.asarray(self.segments, dtype=object)[keep])
+            )
             chain = Chain(self.segments)
             table = length_table(chain.velocity, chain.count)
         object.__setattr__(self, "chain", chain)
@@ -72,7 +76,10 @@ class Track:
     def bbox(self) -> tuple[float, float, float, float]:
         """Exact (xmin, ymin, xmax, ymax) of the centreline: ends and axis extrema of segments."""
         pts = np.concatenate(
-            [seg.point(np.concatenate([[0.0, 1.0], seg.extremum_params()])) for seg in self.segments]
+            [
+                seg.point(np.concatenate([[0.0, 1.0], seg.extremum_params()]))
+                for seg in self.segments
+            ]
         )
         (xmin, ymin), (xmax, ymax) = pts.min(axis=0), pts.max(axis=0)
         return float(xmin), float(ymin), float(xmax), float(ymax)
@@ -158,8 +165,15 @@ class Track:
         """Profile columns plus cos/sin of the heading, the loop's repeated end point dropped."""
         prof = self.sample(spacing, wheelbase)
         table = np.column_stack(
-            [prof.s, prof.x, prof.y, prof.heading, prof.steering_deg,
-             np.cos(prof.heading), np.sin(prof.heading)]
+            [
+                prof.s,
+                prof.x,
+                prof.y,
+                prof.heading,
+                prof.steering_deg,
+                np.cos(prof.heading),
+                np.sin(prof.heading),
+            ]
         )
         table = table[:-1] if self.closed else table
         self._targets[(spacing, wheelbase)] = table

@@ -11,7 +11,14 @@ from tracks._errors import TrackError
 
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _ITEM = re.compile(r"\s*,?\s*(matrix|translate|scale|rotate|skewX|skewY)\s*\(([^)]*)\)\s*")
-_ARITY = {"matrix": (6,), "translate": (1, 2), "scale": (1, 2), "rotate": (1, 3), "skewX": (1,), "skewY": (1,)}
+_ARITY = {
+    "matrix": (6,),
+    "translate": (1, 2),
+    "scale": (1, 2),
+    "rotate": (1, 3),
+    "skewX": (1,),
+    "skewY": (1,),
+}
 
 
 def _affine(a: float, b: float, c: float, d: float, e: float, f: float) -> np.ndarray:
@@ -43,7 +50,7 @@ def parse_transform(text: str | None) -> np.ndarray:
     while pos < len(text):
         match = _ITEM.match(text, pos)
         if match is None:
-            raise TrackError(f"bad transform {text!r} at {text[pos:pos + 20]!r}")
+            raise TrackError(f"bad transform {text!r} at {text[pos : pos + 20]!r}")
         kind, args = match.groups()
         values = [float(x) for x in re.findall(_NUMBER, args)]
         if len(values) not in _ARITY[kind] or not all(map(math.isfinite, values)):

@@ -74,6 +74,10 @@ def document_unit_m(attrib: dict[str, str], unit: str | None = None) -> float:
     if not scales:
         return px
     aspect = attrib.get("preserveAspectRatio", "").split()
-    if aspect[:1] == ["none"] and len(scales) == 2 and abs(scales[0] - scales[1]) > 1e-9 * scales[0]:
+    if (
+        aspect[:1] == ["none"]
+        and len(scales) == 2
+        and abs(scales[0] - scales[1]) > 1e-9 * scales[0]
+    ):
         raise TrackError("width/height and viewBox scale x and y differently; pass --unit")
     return max(scales) if aspect[1:] == ["slice"] else min(scales)

@@ -18,7 +18,9 @@ from app.cli._errors import user_errors
 
 track_cli = typer.Typer(help="Inspect, sample and plot Inkscape tracks.", no_args_is_help=True)
 
-FileArg = Annotated[str, typer.Argument(metavar="FILE.svg", help="SVG file, or a library track name.")]
+FileArg = Annotated[
+    str, typer.Argument(metavar="FILE.svg", help="SVG file, or a library track name.")
+]
 UnitOpt = Annotated[
     str | None,
     typer.Option("--unit", help="What one user unit measures: m, cm, mm, in, pt, pc, px."),
@@ -123,5 +125,7 @@ def plot(
         figure_path(output)
         check_sampling(spacing, wheelbase, max_steer_deg)
         track = _load(file, path, unit)
-        written = plot_profile(track, track.sample(spacing, wheelbase, max_steer_deg), output, max_steer_deg)
+        written = plot_profile(
+            track, track.sample(spacing, wheelbase, max_steer_deg), output, max_steer_deg
+        )
     print(written)

@@ -1,0 +1,60 @@
+"""Tracks benchmark: import + resample + profiles of the thesis track, and steering commands.
+
+Run: python benchmarks/bench_tracks.py   (goals: ≤ 10 ms and ≤ 0.1 ms; the 2011 thesis: 5 ms)
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+
+from tracks import library_names, library_path, load_library_track, load_svg
+
+
+def timed(fn, repeat: int) -> tuple[float, float]:
+    """Median and best wall time of ``fn`` in seconds."""
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), min(times)
+
+
+def main() -> None:
+    thesis = library_path("thesis")
+    load_svg(thesis).sample()  # warm the imports
+    rows = [
+        (
+            "import + resample 2 cm + profiles (thesis)",
+            *timed(lambda: load_svg(thesis).sample(), 200),
+            10e-3,
+        )
+    ]
+    for name in library_names():
+        rows.append(
+            (f"  same, {name}", *timed(lambda n=name: load_library_track(n).sample(), 50), None)
+        )
+    track = load_svg(thesis)
+    prof = track.sample()
+    poses = [
+        (prof.x[i] + 0.01, prof.y[i] - 0.01, prof.heading[i] + 0.1)
+        for i in range(0, len(prof.s), 37)
+    ]
+    track.steering_commands(*poses[0])
+    cycle = iter(poses * 1000)
+    rows.append(
+        (
+            "10 steering commands from a pose (thesis)",
+            *timed(lambda: track.steering_commands(*next(cycle)), 2000),
+            0.1e-3,
+        )
+    )
+    print(f"{'case':46} {'median':>10} {'best':>10} {'goal':>10}")
+    for label, median, best, goal in rows:
+        goal_text = f"{goal * 1e3:.3g} ms" if goal else ""
+        print(f"{label:46} {median * 1e3:8.3f} ms {best * 1e3:7.3f} ms {goal_text:>10}")
+
+
+if __name__ == "__main__":
+    main()
