@@ -25,7 +25,7 @@ from planner._dubins import dubins_to_point
 from planner._paths import path_end, truncate, wrap_angle
 from planner._rng import uniform
 from planner._steer import steer_length, steer_path
-from planner._world import World, motion_free
+from planner._world import World, motion_free, static_clearance_estimate
 
 # Parameter vector indices.
 (EPS, GAMMA, GOAL_BIAS, RHO, SPEED, GX, GY, GTH, GPOS, GHEAD, INFORMED, STAR, REVERSE,
@@ -161,23 +161,26 @@ def _sample(tree: Tree, w: World, P: np.ndarray):
 
 
 @njit(cache=True, inline="always")
-def _lower_bound(tree: Tree, P, node, qx, qy, qth, best) -> float:
-    """A cheap lower bound of the car path length from a node to a pose, tightened in steps
-    only while it stays below ``best``.
+def _cheap_bound(x0, y0, th0, x1, y1, th1, rho) -> float:
+    """A lower bound of every car path length between two poses: the path is at least the
+    straight line, and it turns the heading by at least |Δθ| at curvature ≤ 1/ρ."""
+    return max(math.hypot(x1 - x0, y1 - y0), rho * abs(wrap_angle(th1 - th0)))
 
-    Every path is at least the straight line and turns the heading by at least |Δθ| at
-    curvature ≤ 1/ρ. A forward-only (Dubins) path is moreover at least the shortest path to
-    the query's position ignoring its heading, and — driven backwards from the query — at
-    least the shortest path from the query to the node's position.
-    """
-    x, y, th = tree.pose[node, 0], tree.pose[node, 1], tree.pose[node, 2]
-    e = max(math.hypot(qx - x, qy - y), P[RHO] * abs(wrap_angle(qth - th)))
-    if e >= best or P[REVERSE] > 0.0:
-        return e
-    a = dubins_to_point(x, y, th, qx, qy, P[RHO])
-    if a >= best:
-        return a
-    return max(a, dubins_to_point(qx, qy, qth + math.pi, x, y, P[RHO]))
+
+@njit(cache=True, inline="always")
+def _tight_bound(x0, y0, th0, x1, y1, th1, rho) -> float:
+    """A tighter lower bound for forward-only (Dubins) paths: the shortest path to the second
+    pose's position (any heading), and backwards from the second pose to the first position."""
+    a = dubins_to_point(x0, y0, th0, x1, y1, rho)
+    return max(a, dubins_to_point(x1, y1, th1 + math.pi, x0, y0, rho))
+
+
+@njit(cache=True, inline="always")
+def _can_beat(P, x0, y0, th0, x1, y1, th1, bound) -> bool:
+    """False when a bound already proves the path from pose 0 to pose 1 is ≥ ``bound``."""
+    if _cheap_bound(x0, y0, th0, x1, y1, th1, P[RHO]) >= bound:
+        return False
+    return P[REVERSE] > 0.0 or _tight_bound(x0, y0, th0, x1, y1, th1, P[RHO]) < bound
 
 
 @njit(cache=True, inline="always")
@@ -233,6 +236,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
     best, besti = math.inf, -1
     k = 0
     last_ring = max(nx, ny)
+    tighten = P[REVERSE] == 0.0
     while True:
         ring_bound = max(0.0, (k - 1) * cell) if k <= last_ring else math.inf
         if size > 0 and keys[0] <= ring_bound:
@@ -240,6 +244,15 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             if key >= best:
                 break  # every remaining candidate, opened or not, is at least this far
             size = _heap_pop(keys, vals, size)
+            if node >= 0 and tighten:
+                # First time at the top: tighten the bound and queue it again (-1 - node
+                # marks "tightened"); only few nodes ever get here.
+                tight = _tight_bound(tree.pose[node, 0], tree.pose[node, 1],
+                                     tree.pose[node, 2], qx, qy, qth, P[RHO])
+                if tight < best:
+                    size = _heap_push(keys, vals, size, max(tight, key), -1 - node)
+                continue
+            node = node if node >= 0 else -1 - node
             d = steer_length(P[REVERSE], tree.pose[node, 0], tree.pose[node, 1],
                              tree.pose[node, 2], qx, qy, qth, P[RHO], best)
             if d < best:
@@ -250,7 +263,8 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             for q in range(_ring_cells(tree, ci, cj, k, cells)):
                 node = tree.cell_head[cells[q]]
                 while node >= 0:
-                    lb = _lower_bound(tree, P, node, qx, qy, qth, best)
+                    lb = _cheap_bound(tree.pose[node, 0], tree.pose[node, 1],
+                                      tree.pose[node, 2], qx, qy, qth, P[RHO])
                     if lb < best:
                         size = _heap_push(keys, vals, size, lb, node)
                     node = tree.cell_next[node]
@@ -421,6 +435,8 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
         if j == parent or tree.cost[j] + tree.near_len[q] >= c_new - 1e-12:
             continue
         bound = min(radius, c_new - tree.cost[j])
+        if not _can_beat(P, tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], x, y, th, bound):
+            continue
         d = steer_length(P[REVERSE], tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2],
                          x, y, th, P[RHO], bound)
         if d < bound:
@@ -469,15 +485,6 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
             break  # RRT ends at its first solution, whatever the batch size
         tree.cnt[ITER] += 1
         xr, yr, thr = _sample(tree, w, P)
-        near_i, dist = nearest(tree, P, xr, yr, thr)
-        nx0, ny0, nth0 = tree.pose[near_i, 0], tree.pose[near_i, 1], tree.pose[near_i, 2]
-        steer_path(P[REVERSE], nx0, ny0, nth0, xr, yr, thr, P[RHO], kinds, lens)
-        if dist > P[EPS]:
-            truncate(kinds, lens, P[EPS], cut)
-            lens[:] = cut
-            dist = P[EPS]
-        x, y, th = path_end(nx0, ny0, nth0, kinds, lens, P[RHO])
-        th = wrap_angle(th)
         row = -1
         if record:
             row = ev.cnt[0]
@@ -487,6 +494,20 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
             ev.rows[row, EV_XR] = xr
             ev.rows[row, EV_YR] = yr
             ev.rows[row, EV_THR] = thr
+        if static_clearance_estimate(w, xr, yr) <= 0.0:
+            # SampleFree: a sample inside a static obstacle is rejected at once (it still
+            # counts as an iteration, as OMPL counts its rejected informed samples).
+            continue
+        near_i, dist = nearest(tree, P, xr, yr, thr)
+        nx0, ny0, nth0 = tree.pose[near_i, 0], tree.pose[near_i, 1], tree.pose[near_i, 2]
+        steer_path(P[REVERSE], nx0, ny0, nth0, xr, yr, thr, P[RHO], kinds, lens)
+        if dist > P[EPS]:
+            truncate(kinds, lens, P[EPS], cut)
+            lens[:] = cut
+            dist = P[EPS]
+        x, y, th = path_end(nx0, ny0, nth0, kinds, lens, P[RHO])
+        th = wrap_angle(th)
+        if record:
             ev.rows[row, EV_NEAREST] = near_i
         if dist <= 0.0:
             continue
@@ -533,8 +554,9 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
             if j == parent:
                 continue
             budget = min(tree.cost[j] - c_new, radius)
-            if tree.near_len[q] >= budget - 1e-9:
-                continue  # even a straight line could not make j cheaper
+            if tree.near_len[q] >= budget - 1e-9 or not _can_beat(
+                    P, x, y, th, tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], budget):
+                continue  # not even the lower bound could make j cheaper
             l = steer_length(P[REVERSE], x, y, th, tree.pose[j, 0], tree.pose[j, 1],
                              tree.pose[j, 2], P[RHO], budget)
             if l >= budget - 1e-9:

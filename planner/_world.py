@@ -214,6 +214,14 @@ def clearance(w: World, x: float, y: float, t: float) -> float:
     return _obstacle_clearance(w, x, y, t, True, c)
 
 
+@njit(cache=True, inline="always")
+def static_clearance_estimate(w: World, x: float, y: float) -> float:
+    """Static clearance at the nearest distance-grid cell centre (within h/√2 of the truth)."""
+    i = min(max(int((x - w.sdf_geo[0]) / w.sdf_geo[2]), 0), w.sdf.shape[0] - 1)
+    j = min(max(int((y - w.sdf_geo[1]) / w.sdf_geo[2]), 0), w.sdf.shape[1] - 1)
+    return w.sdf[i, j]
+
+
 @njit(cache=True)
 def clearance_bound(w: World, x: float, y: float, t: float) -> float:
     """A lower bound of `clearance`, exact near obstacles and O(1) in open space.
