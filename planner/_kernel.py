@@ -423,37 +423,36 @@ def _update_best(tree: Tree) -> None:
 @njit(cache=True)
 def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, kinds, lens,
                    pk, pl, counter):
-    """Cheapest collision-free parent among the near candidates (branch and bound).
+    """Cheapest collision-free parent among the near candidates, best first.
 
-    A candidate j can only win if cost(j) + |j - x_new| < the best cost so far, so most are
-    dismissed without a steering computation; the rest are tried cheapest first until one edge
-    is free. Returns (cost, parent) and leaves the winning edge in kinds/lens.
+    Candidates enter a min-heap keyed by cost(j) + a lower bound of their path to x_new; a
+    popped bound is replaced by the exact length (re-queued as ``-1 - j``), a popped exact key
+    is the cheapest remaining candidate and gets its motion check. So exact lengths are
+    computed only for candidates whose bound beats the answer. Returns (cost, parent) and
+    leaves the winning edge in kinds/lens.
     """
-    k = 0
+    keys, vals = tree.near_key, tree.stack
+    size = 0
     for q in range(m):
         j = tree.near[q]
-        if j == parent or tree.cost[j] + tree.near_len[q] >= c_new - 1e-12:
+        if j == parent:
             continue
-        bound = min(radius, c_new - tree.cost[j])
-        if not _can_beat(P, tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], x, y, th, bound):
-            continue
-        d = steer_length(P[REVERSE], tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2],
-                         x, y, th, P[RHO], bound)
-        if d < bound:
-            tree.stack[k] = j
-            tree.near_key[k] = tree.cost[j] + d
-            k += 1
-    while k > 0:
-        best = 0
-        for q in range(1, k):
-            if tree.near_key[q] < tree.near_key[best]:
-                best = q
-        j = tree.stack[best]
-        key = tree.near_key[best]
-        k -= 1
-        tree.stack[best] = tree.stack[k]
-        tree.near_key[best] = tree.near_key[k]
+        lb = max(tree.near_len[q], P[RHO] * abs(wrap_angle(th - tree.pose[j, 2])))
+        if lb < radius and tree.cost[j] + lb < c_new - 1e-12:
+            size = _heap_push(keys, vals, size, tree.cost[j] + lb, j)
+    while size > 0 and keys[0] < c_new - 1e-12:
+        key, v = keys[0], vals[0]
+        size = _heap_pop(keys, vals, size)
+        j = v if v >= 0 else -1 - v
         px, py, pth = tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2]
+        if v >= 0:
+            bound = min(radius, c_new - tree.cost[j])
+            if P[REVERSE] == 0.0 and _tight_bound(px, py, pth, x, y, th, P[RHO]) >= bound:
+                continue
+            d = steer_length(P[REVERSE], px, py, pth, x, y, th, P[RHO], bound)
+            if d < bound:
+                size = _heap_push(keys, vals, size, tree.cost[j] + d, -1 - j)
+            continue
         steer_path(P[REVERSE], px, py, pth, x, y, th, P[RHO], pk, pl)
         tree.cnt[CHECKS] += 1
         if motion_free(w, px, py, pth, tree.cost[j] / P[SPEED], pk, pl, P[RHO], P[SPEED],

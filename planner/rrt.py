@@ -57,13 +57,16 @@ class PlannerSettings:
         """Fill the derived defaults: ε from the workspace size, γ as OMPL's RRT* does."""
         xmin, ymin, xmax, ymax = problem.bounds
         diag = math.hypot(xmax - xmin, ymax - ymin)
-        eps = self.eps if self.eps is not None else max(0.1 * diag, 2.0 * problem.rho)
+        eps = self.eps if self.eps is not None else max(0.15 * diag, 2.0 * problem.rho)
         if self.gamma is not None:
             gamma = self.gamma
         else:
-            # γ > γ* = (2 (1 + 1/d) μ(X) / ζ_d)^(1/d) with d = 3, μ = area · 2π, ζ_3 = 4π/3.
+            # γ* = (2 (1 + 1/d) μ(X) / ζ_d)^(1/d) with d = 3, μ = area · 2π, ζ_3 = 4π/3.
+            # OMPL takes 1.1 γ*; we take 2.2 γ*: at our iteration rates log(n)/n shrinks the
+            # radius to a fraction of a turning circle within milliseconds, and short rewiring
+            # radii cannot straighten a loop (benchmarks/results/planner.md: cost after 1 s).
             measure = (xmax - xmin) * (ymax - ymin) * 2.0 * math.pi
-            gamma = 1.1 * (2.0 * (4.0 / 3.0) * measure / (4.0 * math.pi / 3.0)) ** (1.0 / 3.0)
+            gamma = 2.2 * (2.0 * (4.0 / 3.0) * measure / (4.0 * math.pi / 3.0)) ** (1.0 / 3.0)
         informed = self.informed if self.informed is not None else self.algorithm == "rrtstar"
         speed = self.speed if self.speed is not None else problem.speed
         return dataclasses.replace(self, eps=eps, gamma=gamma, informed=informed, speed=speed)
