@@ -45,18 +45,21 @@ class World(NamedTuple):
     m_wp: np.ndarray  # (nw, 3) t, dx, dy
     sdf: np.ndarray  # (nx, ny) static clearance at cell centres (a lower-bound lookup table)
     sdf_geo: np.ndarray  # float64[3]: x0, y0, cell size
+    lane: np.ndarray  # (nx, ny) driving direction of the nearest centreline point, NaN
+    #                   where unknown; (0, 0) without a track. A sampling hint, not a rule.
 
 
 def _edges(points: np.ndarray) -> np.ndarray:
     return np.hstack([points, np.roll(points, -1, axis=0)])
 
 
-def build_world(bounds, radius, circles, polygons, motions, rings=()) -> World:
+def build_world(bounds, radius, circles, polygons, motions, rings=(), centreline=None) -> World:
     """Pack plain geometry into a `World`.
 
     ``circles``: list of (cx, cy, r, motion_index); ``polygons``: list of ((n, 2) points,
     motion_index); ``motions``: list of ("velocity", (vx, vy)) or ("waypoints", (m, 3) array);
-    ``rings``: polygon rings of the drivable region (empty: the bounds alone).
+    ``rings``: polygon rings of the drivable region (empty: the bounds alone);
+    ``centreline``: (n, 3) x, y, heading of a track, for the lane-direction sampling hint.
     """
     circ = np.array([c[:3] for c in circles], dtype=float).reshape(-1, 3)
     circ_motion = np.array([c[3] for c in circles], dtype=np.int64)
@@ -92,8 +95,11 @@ def build_world(bounds, radius, circles, polygons, motions, rings=()) -> World:
     nx, ny = math.ceil((xmax - xmin) / h), math.ceil((ymax - ymin) / h)
     world = World(geo, circ, circ_motion, poly_edges, poly_start, poly_bbox, poly_motion,
                   ring_edges, m_kind, m_vel, m_wp_start, m_wp, np.zeros((nx, ny)),
-                  np.array([xmin, ymin, h]))
+                  np.array([xmin, ymin, h]),
+                  np.full((nx, ny) if centreline is not None else (0, 0), np.nan))
     _fill_sdf(world)
+    if centreline is not None:
+        _fill_lane(world, np.asarray(centreline, dtype=float))
     return world
 
 
@@ -200,6 +206,23 @@ def _fill_sdf(w: World) -> None:
     for i in range(w.sdf.shape[0]):
         for j in range(w.sdf.shape[1]):
             w.sdf[i, j] = _static_clearance(w, x0 + (i + 0.5) * h, y0 + (j + 0.5) * h)
+
+
+@njit(cache=True)
+def _fill_lane(w: World, centreline: np.ndarray) -> None:
+    """Heading of the nearest centreline point, for every free cell (brute force, once)."""
+    x0, y0, h = w.sdf_geo[0], w.sdf_geo[1], w.sdf_geo[2]
+    for i in range(w.sdf.shape[0]):
+        for j in range(w.sdf.shape[1]):
+            if w.sdf[i, j] <= -h:
+                continue
+            x, y = x0 + (i + 0.5) * h, y0 + (j + 0.5) * h
+            best = math.inf
+            for k in range(centreline.shape[0]):
+                d = (centreline[k, 0] - x) ** 2 + (centreline[k, 1] - y) ** 2
+                if d < best:
+                    best = d
+                    w.lane[i, j] = centreline[k, 2]
 
 
 @njit(cache=True)

@@ -41,11 +41,13 @@ class Problem:
         return float(clearance(self.world, x, y, t))
 
 
-def _track_region(scenario: Scenario):
-    import tracks  # imported lazily: a track is optional, and tracks needs svg libraries
+def _track_region(scenario: Scenario, load_track):
+    if load_track is None:
+        import tracks  # imported lazily: a track is optional, and tracks needs svg libraries
 
+        load_track = tracks.load_library_track
     try:
-        track = tracks.load_library_track(scenario.track.name)
+        track = load_track(scenario.track.name)
     except (KeyError, ValueError) as exc:
         raise ScenarioError(f"track: {exc}") from None
     if scenario.track.width_m is not None:
@@ -64,9 +66,13 @@ def _follow_waypoints(track, follow, step_s: float = 0.05) -> np.ndarray:
     return np.column_stack([times, x - x[0], y - y[0]])
 
 
-def compile_problem(scenario: Scenario) -> Problem:
-    """Compile and sanity-check a scenario; raises ScenarioError for unplannable input."""
-    track = _track_region(scenario) if scenario.track is not None else None
+def compile_problem(scenario: Scenario, load_track=None) -> Problem:
+    """Compile and sanity-check a scenario; raises ScenarioError for unplannable input.
+
+    ``load_track(name) -> tracks.Track`` resolves ``scenario.track.name`` (default: the track
+    library); the server passes one that also knows uploaded tracks.
+    """
+    track = _track_region(scenario, load_track) if scenario.track is not None else None
     rings = track.region_rings() if track is not None else []
     if scenario.bounds is not None:
         bounds = scenario.bounds
@@ -91,7 +97,12 @@ def compile_problem(scenario: Scenario) -> Problem:
             polygons.append((ob.corners(), m))
         else:
             polygons.append((ob.points, m))
-    world = build_world(bounds, scenario.vehicle.radius, circles, polygons, motions, rings)
+    centreline = None
+    if track is not None:
+        prof = track.sample(spacing=0.05)
+        centreline = np.column_stack([prof.x, prof.y, prof.heading])
+    world = build_world(bounds, scenario.vehicle.radius, circles, polygons, motions, rings,
+                        centreline)
     tol = scenario.goal_tolerance
     problem = Problem(
         scenario=scenario, world=world, start=tuple(scenario.start), goal=tuple(scenario.goal),

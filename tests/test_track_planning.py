@@ -1,0 +1,31 @@
+"""Planning on a library track: the drivable region comes from the tracks layer."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+import planner
+import tracks
+from checker import densify
+
+SCENARIO = Path(__file__).parent / "data" / "thesis_half_lap.json"
+
+
+def test_half_lap_of_the_thesis_track_stays_on_the_track_and_off_the_box():
+    data = json.loads(SCENARIO.read_text())
+    result = planner.solve(planner.parse_scenario(data), time_limit=None, iterations=6000)
+    assert result.solved
+    # Independent check with shapely: the car's disc stays inside the drivable region.
+    outer, *holes = tracks.load_library_track("thesis").region_rings()
+    region = shapely.Polygon(outer, holes)
+    radius = data["vehicle"]["radius"]
+    dense = densify(result.path[:, [0, 1, 2, 5]], 0.005)
+    discs = shapely.buffer(shapely.points(dense[:, :2]), radius)
+    assert shapely.contains(region, discs).all()
+    box = shapely.box(0.434, -1.942, 0.534, -1.642)
+    assert not shapely.intersects(box, discs).any()
+    # The goal is half a lap ahead: the path follows the track, it does not cut across.
+    assert 6.0 < result.cost < 7.5
+    assert np.abs(result.path[:, 3]).max() <= 1 / 0.9021 + 1e-9
