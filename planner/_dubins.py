@@ -134,7 +134,9 @@ def dubins_to_point(x, y, th, px, py, rho) -> float:
     u = c * dx + s * dy
     v = abs(-s * dx + c * dy)  # mirror to the left side
     dc = math.hypot(u, v - rho)
-    if dc < rho:
+    if dc < rho or math.hypot(u, v) < 1e-9:
+        # Inside a turning circle, or (nearly) at the point already, where the exact Dubins
+        # code counts it as reached: the straight line is the bound.
         return math.hypot(u, v)
     phi = _mod2pi(math.atan2(v - rho, u) + 0.5 * math.pi - math.acos(rho / dc))
     return rho * phi + math.sqrt(dc * dc - rho * rho)

@@ -72,7 +72,8 @@ def test_straight_lines_have_zero_curvature_and_constant_heading(p0, p1):
         return
     prof = track_of(line(p0, p1)).sample(spacing=0.05)
     assert np.all(prof.curvature == 0.0)
-    assert np.allclose(prof.heading, math.atan2(*(p1 - p0)[::-1]), atol=1e-12)
+    turn = np.remainder(prof.heading - math.atan2(*(p1 - p0)[::-1]) + math.pi, 2 * math.pi)
+    assert np.allclose(turn - math.pi, 0.0, atol=1e-12)  # equal headings modulo 2π (±π)
     assert np.all(prof.steering_deg == 0.0) and prof.feasible.all()
 
 

@@ -328,6 +328,8 @@ def test_export_then_import_gives_the_same_geometry(pieces, width):
         track = Track(name="round trip", closed=False, width_m=width, segments=segments)
     except TrackError:
         return
+    if track.length_m < 1e-6:
+        return  # a point, not a track: open and closed cannot be told apart
     back = load_svg(track.to_svg().encode())
     assert back.width_m == pytest.approx(width, abs=1e-12)
     ends_meet = np.allclose(segments[0].start, segments[-1].end, atol=1e-9)
