@@ -138,5 +138,7 @@ def dubins_to_point(x, y, th, px, py, rho) -> float:
         # Inside a turning circle, or (nearly) at the point already, where the exact Dubins
         # code counts it as reached: the straight line is the bound.
         return math.hypot(u, v)
-    phi = _mod2pi(math.atan2(v - rho, u) + 0.5 * math.pi - math.acos(rho / dc))
+    phi = _mod2pi(math.atan2(v - rho, u) + 0.5 * math.pi - math.acos(min(rho / dc, 1.0)))
+    if phi > 2.0 * math.pi - 1e-7:
+        phi = 0.0  # rounding of "straight ahead": a smaller bound is always a valid one
     return rho * phi + math.sqrt(dc * dc - rho * rho)

@@ -24,14 +24,15 @@ from planner._paths import advance
 
 CONTACT = 1e-4
 # Indices into World.geo.
-XMIN, YMIN, XMAX, YMAX, RADIUS, VMAX_OBS, HAS_REGION = range(7)
+XMIN, YMIN, XMAX, YMAX, RADIUS, VMAX_OBS, HAS_REGION, REACH = range(8)
 STATIC, VELOCITY, WAYPOINTS = 0, 1, 2
 
 
 class World(NamedTuple):
     """Everything a validity check reads, as arrays (a numba-friendly record)."""
 
-    geo: np.ndarray  # float64[7], see the index constants
+    geo: np.ndarray  # float64[8], see the index constants (RADIUS: the smallest disc's)
+    discs: np.ndarray  # (k, 2) the car's footprint as discs: offset along the heading, radius
     circ: np.ndarray  # (nc, 3) cx, cy, radius
     circ_motion: np.ndarray  # (nc,) index into the motion table, -1 when static
     poly_edges: np.ndarray  # (ne, 4) x1, y1, x2, y2 of all polygon edges
@@ -53,14 +54,18 @@ def _edges(points: np.ndarray) -> np.ndarray:
     return np.hstack([points, np.roll(points, -1, axis=0)])
 
 
-def build_world(bounds, radius, circles, polygons, motions, rings=(), centreline=None) -> World:
+def build_world(bounds, radius, circles, polygons, motions, rings=(), centreline=None,
+                discs=None) -> World:
     """Pack plain geometry into a `World`.
 
     ``circles``: list of (cx, cy, r, motion_index); ``polygons``: list of ((n, 2) points,
     motion_index); ``motions``: list of ("velocity", (vx, vy)) or ("waypoints", (m, 3) array);
     ``rings``: polygon rings of the drivable region (empty: the bounds alone);
-    ``centreline``: (n, 3) x, y, heading of a track, for the lane-direction sampling hint.
+    ``centreline``: (n, 3) x, y, heading of a track, for the lane-direction sampling hint;
+    ``discs``: the footprint as (offset along the heading, radius) rows; default one disc of
+    ``radius`` at the reference point.
     """
+    discs = np.array([[0.0, radius]] if discs is None else discs, dtype=float).reshape(-1, 2)
     circ = np.array([c[:3] for c in circles], dtype=float).reshape(-1, 3)
     circ_motion = np.array([c[3] for c in circles], dtype=np.int64)
     pts = [np.asarray(p, dtype=float) for p, _ in polygons]
@@ -89,11 +94,12 @@ def build_world(bounds, radius, circles, polygons, motions, rings=(), centreline
                 vmax = max(vmax, float(step.max()))
     m_wp_start = np.concatenate([[0], np.cumsum([len(w) for w in wps])]).astype(np.int64)
     m_wp = np.vstack(wps) if wps else np.zeros((0, 3))
-    geo = np.array([*bounds, radius, vmax, 1.0 if len(ring_edges) else 0.0], dtype=float)
+    geo = np.array([*bounds, discs[:, 1].min(), vmax, 1.0 if len(ring_edges) else 0.0,
+                    np.abs(discs[:, 0]).max()], dtype=float)
     xmin, ymin, xmax, ymax = bounds
     h = max(math.hypot(xmax - xmin, ymax - ymin) / 500.0, 0.01)
     nx, ny = math.ceil((xmax - xmin) / h), math.ceil((ymax - ymin) / h)
-    world = World(geo, circ, circ_motion, poly_edges, poly_start, poly_bbox, poly_motion,
+    world = World(geo, discs, circ, circ_motion, poly_edges, poly_start, poly_bbox, poly_motion,
                   ring_edges, m_kind, m_vel, m_wp_start, m_wp, np.zeros((nx, ny)),
                   np.array([xmin, ymin, h]),
                   np.full((nx, ny) if centreline is not None else (0, 0), np.nan))
@@ -152,9 +158,9 @@ def _edges_distance(edges, a, b, px, py):
 
 
 @njit(cache=True)
-def _obstacle_clearance(w: World, x: float, y: float, t: float, moving: bool, c: float) -> float:
-    """min(c, clearance to the moving (or the static) obstacles at time t)."""
-    r = w.geo[RADIUS]
+def _point_obstacles(w: World, x: float, y: float, t: float, moving: bool, c: float) -> float:
+    """min(c, distance from the point (x, y) to the moving (or the static) obstacles at t),
+    negative inside one."""
     for i in range(w.circ.shape[0]):
         m = w.circ_motion[i]
         if (m >= 0) != moving:
@@ -164,7 +170,7 @@ def _obstacle_clearance(w: World, x: float, y: float, t: float, moving: bool, c:
             ox, oy = offset(w, m, t)
             cx += ox
             cy += oy
-        d = math.hypot(x - cx, y - cy) - w.circ[i, 2] - r
+        d = math.hypot(x - cx, y - cy) - w.circ[i, 2]
         if d < c:
             c = d
     for p in range(w.poly_bbox.shape[0]):
@@ -178,26 +184,26 @@ def _obstacle_clearance(w: World, x: float, y: float, t: float, moving: bool, c:
             py -= oy
         bx = max(w.poly_bbox[p, 0] - px, 0.0, px - w.poly_bbox[p, 2])
         by = max(w.poly_bbox[p, 1] - py, 0.0, py - w.poly_bbox[p, 3])
-        if math.hypot(bx, by) - r >= c:
+        if math.hypot(bx, by) >= c:
             continue  # this polygon cannot be nearer than what we have
         d, inside = _edges_distance(w.poly_edges, w.poly_start[p], w.poly_start[p + 1], px, py)
-        d = -d - r if inside else d - r
+        d = -d if inside else d
         if d < c:
             c = d
     return c
 
 
 @njit(cache=True)
-def _static_clearance(w: World, x: float, y: float) -> float:
-    """Exact clearance to the bounds, the drivable region and the obstacles that never move."""
-    r = w.geo[RADIUS]
-    c = min(x - w.geo[XMIN], w.geo[XMAX] - x, y - w.geo[YMIN], w.geo[YMAX] - y) - r
+def _point_static(w: World, x: float, y: float) -> float:
+    """Signed distance from a point to the bounds, the drivable region's edge and the static
+    obstacles (the car's size is subtracted per footprint disc by the callers)."""
+    c = min(x - w.geo[XMIN], w.geo[XMAX] - x, y - w.geo[YMIN], w.geo[YMAX] - y)
     if w.geo[HAS_REGION] > 0.0:
         d, inside = _edges_distance(w.ring_edges, 0, w.ring_edges.shape[0], x, y)
-        d = d - r if inside else -d - r
+        d = d if inside else -d
         if d < c:
             c = d
-    return _obstacle_clearance(w, x, y, 0.0, False, c)
+    return _point_obstacles(w, x, y, 0.0, False, c)
 
 
 @njit(cache=True)
@@ -205,7 +211,7 @@ def _fill_sdf(w: World) -> None:
     x0, y0, h = w.sdf_geo[0], w.sdf_geo[1], w.sdf_geo[2]
     for i in range(w.sdf.shape[0]):
         for j in range(w.sdf.shape[1]):
-            w.sdf[i, j] = _static_clearance(w, x0 + (i + 0.5) * h, y0 + (j + 0.5) * h)
+            w.sdf[i, j] = _point_static(w, x0 + (i + 0.5) * h, y0 + (j + 0.5) * h)
 
 
 @njit(cache=True)
@@ -226,44 +232,63 @@ def _fill_lane(w: World, centreline: np.ndarray) -> None:
 
 
 @njit(cache=True)
-def clearance(w: World, x: float, y: float, t: float) -> float:
-    """Signed clearance of the car's disc at (x, y) at time t; > 0 means valid.
+def pose_clearance(w: World, x: float, y: float, th: float, t: float) -> float:
+    """Signed clearance of the car's footprint at pose (x, y, th) at time t; > 0 means valid.
 
     ``t`` NaN means "static obstacles only" (FORMAT.md: the goal has no time condition).
     """
-    c = _static_clearance(w, x, y)
-    if t != t:
-        return c
-    return _obstacle_clearance(w, x, y, t, True, c)
+    c = math.inf
+    for k in range(w.discs.shape[0]):
+        a, r = w.discs[k, 0], w.discs[k, 1]
+        cx, cy = x + a * math.cos(th), y + a * math.sin(th)
+        d = _point_static(w, cx, cy)
+        if t == t:
+            d = _point_obstacles(w, cx, cy, t, True, d)
+        c = min(c, d - r)
+    return c
+
+
+@njit(cache=True)
+def clearance(w: World, x: float, y: float, t: float) -> float:
+    """Clearance of a car heading along +x at (x, y): exact for disc footprints (FORMAT.md),
+    where the heading does not matter."""
+    return pose_clearance(w, x, y, 0.0, t)
 
 
 @njit(cache=True, inline="always")
 def static_clearance_estimate(w: World, x: float, y: float) -> float:
-    """Static clearance at the nearest distance-grid cell centre (within h/√2 of the truth)."""
+    """Static clearance of the smallest footprint disc centred at (x, y), from the nearest grid
+    cell centre (within h/√2 of the truth): for sampling."""
     i = min(max(int((x - w.sdf_geo[0]) / w.sdf_geo[2]), 0), w.sdf.shape[0] - 1)
     j = min(max(int((y - w.sdf_geo[1]) / w.sdf_geo[2]), 0), w.sdf.shape[1] - 1)
-    return w.sdf[i, j]
+    return w.sdf[i, j] - w.geo[RADIUS]
 
 
 @njit(cache=True)
-def clearance_bound(w: World, x: float, y: float, t: float) -> float:
-    """A lower bound of `clearance`, exact near obstacles and O(1) in open space.
+def clearance_bound(w: World, x: float, y: float, th: float, t: float) -> float:
+    """A lower bound of `pose_clearance`, exact near obstacles and O(1) in open space.
 
-    Clearance is 1-Lipschitz, so the value stored at the nearest cell centre minus the distance
-    to it (≤ h/√2) bounds it from below; only where that bound is small do we compute exactly.
+    Point clearance is 1-Lipschitz, so the value stored at the nearest cell centre minus the
+    distance to it (≤ h/√2) bounds it from below; only where that bound is small do we compute
+    exactly.
     """
     x0, y0, h = w.sdf_geo[0], w.sdf_geo[1], w.sdf_geo[2]
-    i = int((x - x0) / h)
-    j = int((y - y0) / h)
-    if 0 <= i < w.sdf.shape[0] and 0 <= j < w.sdf.shape[1] and x >= x0 and y >= y0:
-        c = w.sdf[i, j] - 0.7072 * h
-        if c < 2.0 * h:
-            c = _static_clearance(w, x, y)
-    else:
-        c = _static_clearance(w, x, y)
-    if w.m_kind.shape[0] == 0:
-        return c
-    return _obstacle_clearance(w, x, y, t, True, c)
+    c = math.inf
+    for k in range(w.discs.shape[0]):
+        a, r = w.discs[k, 0], w.discs[k, 1]
+        cx, cy = x + a * math.cos(th), y + a * math.sin(th)
+        i = int((cx - x0) / h)
+        j = int((cy - y0) / h)
+        if 0 <= i < w.sdf.shape[0] and 0 <= j < w.sdf.shape[1] and cx >= x0 and cy >= y0:
+            d = w.sdf[i, j] - 0.7072 * h - r
+            if d < 2.0 * h:
+                d = _point_static(w, cx, cy) - r
+        else:
+            d = _point_static(w, cx, cy) - r
+        if w.m_kind.shape[0] > 0:
+            d = _point_obstacles(w, cx, cy, t, True, d + r) - r
+        c = min(c, d)
+    return c
 
 
 @njit(cache=True)
@@ -272,7 +297,8 @@ def motion_free(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> boo
 
     ``counter`` (int64[1]) accumulates clearance evaluations, for the metrics.
     """
-    slow = 1.0 + w.geo[VMAX_OBS] / speed
+    # A footprint disc at offset a moves at most (1 + a/ρ) times as far as the car drives.
+    slow = 1.0 + w.geo[VMAX_OBS] / speed + w.geo[REACH] / rho
     driven = 0.0
     for i in range(kinds.shape[0]):
         seg = lens[i]
@@ -282,9 +308,9 @@ def motion_free(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> boo
         direction = 1.0 if seg > 0.0 else -1.0
         s = 0.0
         while True:
-            px, py, _ = advance(x, y, th, kinds[i], direction * s, rho)
+            px, py, pth = advance(x, y, th, kinds[i], direction * s, rho)
             counter[0] += 1
-            d = clearance_bound(w, px, py, t0 + (driven + s) / speed)
+            d = clearance_bound(w, px, py, pth, t0 + (driven + s) / speed)
             if d <= CONTACT:
                 return False
             if s >= length:
@@ -301,5 +327,5 @@ def path_clearances(w: World, samples: np.ndarray, timed: bool) -> np.ndarray:
     out = np.empty(samples.shape[0])
     for k in range(samples.shape[0]):
         t = samples[k, 5] if timed else 0.0
-        out[k] = clearance(w, samples[k, 0], samples[k, 1], t)
+        out[k] = pose_clearance(w, samples[k, 0], samples[k, 1], samples[k, 2], t)
     return out

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._world import World, build_world, clearance
+from planner._world import World, build_world, pose_clearance
 from planner.scenario import Box, Circle, Scenario, ScenarioError
 
 __all__ = ["Problem", "compile_problem"]
@@ -36,9 +36,10 @@ class Problem:
     def bounds(self) -> tuple[float, float, float, float]:
         return tuple(float(v) for v in self.world.geo[:4])
 
-    def clearance(self, x: float, y: float, t: float = 0.0) -> float:
-        """Signed clearance of the car's disc at (x, y) at time t (NaN: static obstacles only)."""
-        return float(clearance(self.world, x, y, t))
+    def clearance(self, x: float, y: float, t: float = 0.0, theta: float = 0.0) -> float:
+        """Signed clearance of the car's footprint at pose (x, y, theta) at time t (NaN: static
+        obstacles only)."""
+        return float(pose_clearance(self.world, x, y, theta, t))
 
 
 def _track_region(scenario: Scenario, load_track):
@@ -102,19 +103,19 @@ def compile_problem(scenario: Scenario, load_track=None) -> Problem:
         prof = track.sample(spacing=0.05)
         centreline = np.column_stack([prof.x, prof.y, prof.heading])
     world = build_world(bounds, scenario.vehicle.radius, circles, polygons, motions, rings,
-                        centreline)
+                        centreline, scenario.vehicle.discs())
     tol = scenario.goal_tolerance
     problem = Problem(
         scenario=scenario, world=world, start=tuple(scenario.start), goal=tuple(scenario.goal),
         goal_position_tol=tol.position, goal_heading_tol=math.radians(tol.heading_deg),
         rho=scenario.vehicle.turning_radius, speed=scenario.vehicle.speed,
         timed=scenario.has_motion)
-    sx, sy, _ = problem.start
-    if problem.clearance(sx, sy, 0.0) <= 0.0:
+    start_clearance = problem.clearance(*problem.start[:2], 0.0, problem.start[2])
+    if start_clearance <= 0.0:
         raise ScenarioError(f"start {list(problem.start)} is in collision or outside the region "
-                            f"at t = 0 (clearance {problem.clearance(sx, sy, 0.0):.3f} m)")
-    gx, gy, _ = problem.goal
-    if problem.clearance(gx, gy, math.nan) <= 0.0:
+                            f"at t = 0 (clearance {start_clearance:.3f} m)")
+    goal_clearance = problem.clearance(*problem.goal[:2], math.nan, problem.goal[2])
+    if goal_clearance <= 0.0:
         raise ScenarioError(f"goal {list(problem.goal)} is in collision or outside the region "
-                            f"(clearance {problem.clearance(gx, gy, math.nan):.3f} m)")
+                            f"(clearance {goal_clearance:.3f} m)")
     return problem

@@ -47,13 +47,37 @@ Point = tuple[float, float]
 Positive = Annotated[float, Field(gt=0)]
 
 
+class Footprint(_Strict):
+    """An oriented rectangle (rich schema): the car's outline, with the rear axle — the pose's
+    reference point — ``rear_overhang`` metres in front of the rear bumper."""
+
+    type: Literal["rectangle"]
+    length: Positive
+    width: Positive
+    rear_overhang: Annotated[float, Field(ge=0)] | None = None
+
+    def discs(self, wheelbase: float) -> list[tuple[float, float]]:
+        """Cover the rectangle exactly by n = ⌈length / width⌉ equal discs along its axis:
+        (offset from the rear axle along the heading, radius) rows."""
+        overhang = (self.rear_overhang if self.rear_overhang is not None
+                    else max(self.length - wheelbase, 0.0) / 2)
+        n = max(1, math.ceil(self.length / self.width - 1e-9))
+        half = self.length / (2 * n)
+        radius = math.hypot(half, self.width / 2)
+        return [(-overhang + half * (2 * i + 1), radius) for i in range(n)]
+
+
 class Vehicle(_Strict):
-    """The car: geometry for planning (v1), speed (v1.1) and limits for simulation (v1.2)."""
+    """The car: geometry for planning (v1), speed (v1.1) and limits for simulation (v1.2).
+
+    The footprint is a disc of ``radius`` (FORMAT.md) or, in the rich schema, a rectangle.
+    """
 
     wheelbase: Positive = 0.44
     max_steer_deg: Annotated[float, Field(gt=0, lt=90)] = 26.0
     min_turning_radius: Positive | None = None
     radius: Annotated[float, Field(ge=0)] = 0.0
+    footprint: Footprint | None = None
     speed: Positive = 1.0
     max_speed: Positive | None = None
     max_accel: Positive = 1.0
@@ -63,7 +87,15 @@ class Vehicle(_Strict):
     def _speeds(self) -> Vehicle:
         if self.max_speed is not None and self.max_speed < self.speed:
             raise ValueError(f"max_speed ({self.max_speed}) is below speed ({self.speed})")
+        if self.footprint is not None and self.radius > 0:
+            raise ValueError("give either 'radius' (a disc) or 'footprint', not both")
         return self
+
+    def discs(self) -> list[tuple[float, float]]:
+        """The footprint as (offset along the heading, radius) discs."""
+        if self.footprint is None:
+            return [(0.0, self.radius)]
+        return self.footprint.discs(self.wheelbase)
 
     @property
     def turning_radius(self) -> float:

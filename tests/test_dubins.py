@@ -43,6 +43,10 @@ def test_known_lengths(q1, expected):
 @settings(max_examples=300, deadline=None)
 @given(pose, pose)
 def test_exact_endpoint_and_length(q0, q1):
+    # Within a micrometre (but not equal), poses sit on Dubins' discontinuity: rounding decides
+    # between "already there" and a full loop.
+    assume(q0 == q1 or math.hypot(q1[0] - q0[0], q1[1] - q0[1]) > 1e-6
+           or abs(math.remainder(q1[2] - q0[2], 2 * math.pi)) > 1e-6)
     length, kinds, lens = shortest(q0, q1)
     end = path_end(*q0, kinds, lens, RHO)
     assert end[:2] == pytest.approx(q1[:2], abs=1e-9)
@@ -80,10 +84,11 @@ def test_bounded_length_never_underestimates(q0, q1, bound):
 @settings(max_examples=300, deadline=None)
 @given(pose, pose)
 def test_to_point_is_a_lower_bound(q0, q1):
+    # 1e-8 m: the Dubins formulas cancel 2 + d² - 2cos(α - β), losing straights under ~10 nm.
     exact = dubins_length(*q0, *q1, RHO, math.inf)
-    assert dubins_to_point(*q0, q1[0], q1[1], RHO) <= exact + 1e-9
+    assert dubins_to_point(*q0, q1[0], q1[1], RHO) <= exact + 1e-8
     back = dubins_to_point(q1[0], q1[1], q1[2] + math.pi, q0[0], q0[1], RHO)
-    assert back <= exact + 1e-9
+    assert back <= exact + 1e-8
 
 
 def test_to_point_matches_the_minimum_over_final_headings():

@@ -52,9 +52,14 @@ class LengthTable:
         return np.bincount(self.segment, weights=np.diff(self.cumulative), minlength=count)
 
 
-def length_table(velocity: Velocity, count: int, rtol: float = 1e-12) -> LengthTable:
-    """Adaptive quadrature over [0, 1] of ``count`` segments, to ``rtol`` of the total length."""
-    idx, a, b = np.arange(count), np.zeros(count), np.ones(count)
+def length_table(velocity: Velocity, count: int, rtol: float = 1e-12,
+                 breaks: list[np.ndarray] | None = None) -> LengthTable:
+    """Adaptive quadrature over [0, 1] of ``count`` segments, to ``rtol`` of the total length;
+    ``breaks`` are parameters per segment where the first intervals must end (cusps)."""
+    edges = [np.concatenate([[0.0], breaks[k] if breaks else [], [1.0]]) for k in range(count)]
+    idx = np.concatenate([np.full(len(e) - 1, k) for k, e in enumerate(edges)])
+    a = np.concatenate([e[:-1] for e in edges])
+    b = np.concatenate([e[1:] for e in edges])
     whole = _gauss(velocity, idx, a, b)
     done_len = 0.0
     accepted = []

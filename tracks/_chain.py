@@ -47,6 +47,24 @@ class Chain:
                 out[arc] = self._arcs(idx[arc], t[arc], order)
         return out
 
+    def kinks(self) -> list[np.ndarray]:
+        """Per segment, the parameters in (0, 1) where x' or y' vanishes.
+
+        |B'| is smooth except where both vanish (a cusp), where it has a kink that slows
+        quadrature and can fool its error estimate; splitting at every root of either component
+        puts any cusp on an interval's end, where the integrand is smooth one-sidedly.
+        """
+        out = []
+        for k in range(self.count):
+            roots: list[float] = []
+            if not self.is_arc[k]:
+                for c in range(2):
+                    p0, p1, p2 = self.first[k, :, c]
+                    roots += [r.real for r in np.roots([p0 - 2 * p1 + p2, 2 * (p1 - p0), p0])
+                              if abs(r.imag) < 1e-12 and 1e-9 < r.real < 1 - 1e-9]
+            out.append(np.unique(roots))
+        return out
+
     def point(self, idx: np.ndarray, t: np.ndarray) -> np.ndarray:
         return self._eval(self.ctrl, idx, t, 0)
 

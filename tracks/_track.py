@@ -51,7 +51,7 @@ class Track:
     def __post_init__(self) -> None:
         _positive("width", self.width_m)
         chain = Chain(self.segments)
-        table = length_table(chain.velocity, chain.count)
+        table = length_table(chain.velocity, chain.count, breaks=chain.kinks())
         keep = table.segment_lengths(chain.count) > 1e-12 * table.length
         if not keep.any():
             raise TrackError(f"track {self.name!r} has zero length")
@@ -60,7 +60,7 @@ class Track:
                 self, "segments", tuple(np.asarray(self.segments, dtype=object)[keep])
             )
             chain = Chain(self.segments)
-            table = length_table(chain.velocity, chain.count)
+            table = length_table(chain.velocity, chain.count, breaks=chain.kinks())
         object.__setattr__(self, "chain", chain)
         object.__setattr__(self, "table", table)
 
