@@ -384,45 +384,35 @@ def _unlink_child(tree: Tree, parent: int, child: int) -> None:
 
 
 @njit(cache=True)
-def _subtree_free_at(tree: Tree, w: World, P: np.ndarray, root: int, delta: float,
+def _collect_subtree(tree: Tree, root: int) -> int:
+    """Write ``root`` and all its descendants into tree.stack (breadth first); their count."""
+    tree.stack[0] = root
+    n = 1
+    i = 0
+    while i < n:
+        c = tree.first_child[tree.stack[i]]
+        while c >= 0:
+            tree.stack[n] = c
+            n += 1
+            c = tree.next_sibling[c]
+        i += 1
+    return n
+
+
+@njit(cache=True)
+def _subtree_free_at(tree: Tree, w: World, P: np.ndarray, n: int, delta: float,
                      counter) -> bool:
-    """Are all edges below ``root`` free when every arrival time moves earlier by delta/v?"""
-    top = 0
-    c = tree.first_child[root]
-    while c >= 0:
-        tree.stack[top] = c
-        top += 1
-        c = tree.next_sibling[c]
-    while top > 0:
-        top -= 1
-        node = tree.stack[top]
+    """Are the edges into the collected subtree's nodes (all but its root, tree.stack[0]) free
+    when every arrival time moves earlier by delta / v?"""
+    for k in range(1, n):
+        node = tree.stack[k]
         par = tree.parent[node]
         t0 = (tree.cost[par] - delta) / P[SPEED]
         tree.cnt[CHECKS] += 1
         if not motion_free(w, tree.pose[par, 0], tree.pose[par, 1], tree.pose[par, 2], t0,
                            tree.kinds[node], tree.lens[node], P[RHO], P[SPEED], counter):
             return False
-        c = tree.first_child[node]
-        while c >= 0:
-            tree.stack[top] = c
-            top += 1
-            c = tree.next_sibling[c]
     return True
-
-
-@njit(cache=True)
-def _shift_subtree_cost(tree: Tree, root: int, delta: float) -> None:
-    top = 1
-    tree.stack[0] = root
-    while top > 0:
-        top -= 1
-        node = tree.stack[top]
-        tree.cost[node] -= delta
-        c = tree.first_child[node]
-        while c >= 0:
-            tree.stack[top] = c
-            top += 1
-            c = tree.next_sibling[c]
 
 
 @njit(cache=True)
@@ -584,7 +574,8 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
                                counter):
                 continue
             delta = tree.cost[j] - (c_new + l)
-            if timed and not _subtree_free_at(tree, w, P, j, delta, counter):
+            n_sub = _collect_subtree(tree, j)
+            if timed and not _subtree_free_at(tree, w, P, n_sub, delta, counter):
                 tree.cnt[REFUSED] += 1
                 continue
             old = tree.parent[j]
@@ -594,7 +585,8 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
             tree.first_child[new] = j
             tree.kinds[j, :] = kinds
             tree.lens[j, :] = lens
-            _shift_subtree_cost(tree, j, delta)
+            for k in range(n_sub):  # the whole subtree arrives earlier by the same Δ
+                tree.cost[tree.stack[k]] -= delta
             tree.cnt[REWIRES] += 1
             changed = True
             if record and ev.cnt[2] < ev.rewires.shape[0]:
