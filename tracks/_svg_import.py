@@ -33,6 +33,7 @@ INKSCAPE_LABEL = "{http://www.inkscape.org/namespaces/inkscape}label"
 _CONTAINERS = frozenset({"g", "svg", "a", "switch"})
 _MAX_ELEMENTS = 20_000
 _MAX_USE_DEPTH = 32
+_MAX_SEGMENTS = 10_000  # per document: measuring each costs ~0.15 ms, so this bounds a load
 
 Source = str | os.PathLike | bytes
 
@@ -144,19 +145,30 @@ def collect_elements(root: ET.Element) -> list[_Element]:
     """Every rendered path-like element of the document, in document order."""
     walker = _Walker(root)
     walker.walk(root, np.eye(3), {})
+    total = 0
+    for elem in walker.found:
+        total += len(_parse(elem))
+        if total > _MAX_SEGMENTS:
+            raise TrackError(f"more than {_MAX_SEGMENTS} path segments in the document")
     return walker.found
 
 
-def _segments(elem: _Element) -> list[list[Segment]]:
-    """The element's subpaths in its local user units (split where the pen jumps)."""
-    from svgpathtools import Arc, Line, parse_path
+def _parse(elem: _Element):
+    from svgpathtools import parse_path
 
     try:
-        parsed = parse_path(elem.path_data)
+        return parse_path(elem.path_data)
     except (ValueError, IndexError, AssertionError, ZeroDivisionError) as exc:
         raise TrackError(
             f"element {elem.id!r}: bad path data: {exc or type(exc).__name__}"
         ) from None
+
+
+def _segments(elem: _Element) -> list[list[Segment]]:
+    """The element's subpaths in its local user units (split where the pen jumps)."""
+    from svgpathtools import Arc, Line
+
+    parsed = _parse(elem)
     subpaths: list[list[Segment]] = []
     previous_end = None
     for seg in parsed:

@@ -23,10 +23,11 @@ cli = typer.Typer(
 
 
 def _register() -> None:
-    from app.cli import _plan, _track
+    from app.cli import _plan, _serve, _track
 
     cli.add_typer(_track.track_cli, name="track")
     _plan.register(cli)
+    _serve.register(cli)
 
 
 _register()

@@ -46,19 +46,16 @@ def plan(
 ) -> None:
     """Plan a path for the car from start to goal with RRT or RRT*."""
     import planner as core
-    from planner.report import plan_report
+    from app.planning import PlanOptions, run_plan
 
     with user_errors():
         if time is not None and not time > 0:
             raise ValueError(f"--time must be > 0, got {time}")
-        budget_time = 1.0 if time is None and iterations is None else time
-        problem = core.compile_problem(core.load_scenario(scenario))
-        settings = core.PlannerSettings(
-            algorithm=planner.value, steering=steering.value, eps=eps, gamma=gamma,
-            k_rrt=k_rrt, goal_bias=goal_bias, informed=informed, seed=seed, speed=speed)
-        result = core.Planner(problem, settings).solve(budget_time, iterations)
-    report = plan_report(result, problem.scenario.name,
-                         {"time": budget_time, "iterations": iterations})
+        options = PlanOptions(
+            planner=planner.value, steering=steering.value, time=time, iterations=iterations,
+            seed=seed, eps=eps, gamma=gamma, k_rrt=k_rrt, goal_bias=goal_bias,
+            informed=informed, speed=speed)
+        report = run_plan(core.load_scenario(scenario), options)
     if as_json:
         typer.echo(report.model_dump_json())
         return

@@ -1,0 +1,109 @@
+"""`trackstar serve`: the REST API (uvicorn) and the browser studio (viser) in one process.
+
+Both ports are checked here, before anything starts: viser would silently move to the next
+free port, and a user must learn that the port they asked for is busy. The API socket is bound
+here and handed to uvicorn, so port 0 works and the printed port is the real one.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import ipaddress
+import signal
+import socket
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from app.cli._errors import InputError, user_errors
+
+
+def _listen(host: str, port: int, what: str) -> socket.socket:
+    """A listening socket on (host, port), or exit 2 naming the busy port."""
+    try:
+        family = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0][0]
+    except socket.gaierror as exc:
+        raise InputError(f"cannot resolve host {host!r}: {exc.strerror}") from None
+    try:
+        return socket.create_server((host, port), family=family)
+    except OSError as exc:
+        raise InputError(f"{what} port {port} on {host} is not available: "
+                         f"{exc.strerror or exc}") from None
+
+
+def _is_loopback(host: str) -> bool:
+    try:
+        address = socket.getaddrinfo(host, None, type=socket.SOCK_STREAM)[0][4][0]
+        return ipaddress.ip_address(address).is_loopback
+    except (OSError, ValueError):
+        return False
+
+
+async def _run(app, api: socket.socket, host: str, ui: socket.socket) -> None:
+    import uvicorn
+
+    from app.studio import launch
+
+    api_port, ui_port = api.getsockname()[1], ui.getsockname()[1]
+    ui.close()  # viser binds it itself; checked free just now
+    studio = await asyncio.to_thread(launch, host, ui_port, f"http://{host}:{api_port}/api/v1")
+    try:
+        if studio.port != ui_port:
+            raise InputError(f"studio port {ui_port} on {host} became busy")
+        config = uvicorn.Config(app, log_level="warning", timeout_graceful_shutdown=1)
+        server = uvicorn.Server(config)
+        serving = asyncio.create_task(server.serve(sockets=[api]))
+        while not server.started and not serving.done():
+            await asyncio.sleep(0.02)
+        if server.started:
+            print(f"API: http://{host}:{api_port}/docs", flush=True)
+            print(f"UI: http://{host}:{ui_port}/", flush=True)
+        await serving
+    finally:
+        studio.stop()
+
+
+def serve(
+    host: Annotated[str, typer.Option(envvar="TRACKSTAR_HOST",
+                                      help="Interface to listen on.")] = "127.0.0.1",
+    port: Annotated[int, typer.Option(envvar="TRACKSTAR_PORT", min=0, max=65535,
+                                      help="REST API port (0: any free port).")] = 8000,
+    ui_port: Annotated[int, typer.Option(envvar="TRACKSTAR_UI_PORT", min=0, max=65535,
+                                         help="Studio port (0: any free port).")] = 8080,
+    data_dir: Annotated[Path | None, typer.Option(
+        envvar="TRACKSTAR_DATA_DIR", file_okay=False,
+        help="Where the SQLite database lives [default: the user data directory].")] = None,
+    max_upload_mb: Annotated[float, typer.Option(min=0.001, help="Upload limit (MB).")] = 5.0,
+    max_plan_s: Annotated[float, typer.Option(min=0.001, help="Longest plan (s).")] = 30.0,
+) -> None:
+    """Serve the REST API (/docs) and the browser studio; Ctrl-C stops both."""
+    import platformdirs
+
+    from app.server import ServerSettings, create_app
+
+    with user_errors():
+        api = _listen(host, port, "API")
+        try:
+            ui = _listen(host, ui_port, "studio")
+        except InputError:
+            api.close()
+            raise
+        if ui_port == 0 and ui.getsockname()[1] == api.getsockname()[1]:
+            raise InputError("the studio and the API need different ports")
+        data = data_dir or Path(platformdirs.user_data_dir("trackstar"))
+        settings = ServerSettings(data_dir=data, max_upload_mb=max_upload_mb,
+                                  max_plan_s=max_plan_s, ui_port=ui.getsockname()[1])
+        if not _is_loopback(host):
+            print(f"warning: listening on {host}: the studio and the API have no "
+                  "authentication; put them behind a reverse proxy that adds it",
+                  file=sys.stderr, flush=True)
+        # uvicorn re-raises the stop signal once it has shut down; we have already stopped.
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, lambda *_: None)
+        asyncio.run(_run(create_app(settings), api, host, ui))
+
+
+def register(cli: typer.Typer) -> None:
+    cli.command("serve")(serve)

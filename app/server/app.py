@@ -1,0 +1,122 @@
+"""The FastAPI application: settings, lifespan (store and worker pool), limits, routes."""
+
+from __future__ import annotations
+
+from contextlib import asynccontextmanager
+from dataclasses import dataclass
+from importlib.metadata import version
+from pathlib import Path
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import FileResponse, JSONResponse
+from fastapi.staticfiles import StaticFiles
+
+from app.server import routes_jobs, routes_plan, routes_scenarios, routes_tracks
+from app.server.jobs import Planning
+from app.server.models import Health
+from app.server.store import Store
+from planner import ScenarioError
+
+STATIC = Path(__file__).resolve().parents[2] / "static"
+DATABASE = "trackstar.sqlite3"
+MULTIPART_SLACK = 64 * 1024  # form fields and boundaries around an upload of the full cap
+
+
+@dataclass(frozen=True)
+class ServerSettings:
+    data_dir: Path
+    max_upload_mb: float = 5.0
+    max_plan_s: float = 30.0
+    ui_port: int | None = None
+    workers: int | None = None  # default: one per CPU available to the process
+
+    @property
+    def max_upload_bytes(self) -> int:
+        return int(self.max_upload_mb * 1024 * 1024)
+
+
+class BodyLimit:
+    """Refuse any request body above the cap with 413, before it is read into memory."""
+
+    def __init__(self, app, max_bytes: int) -> None:
+        self.app, self.max_bytes = app, max_bytes
+
+    async def __call__(self, scope, receive, send) -> None:
+        if scope["type"] != "http":
+            return await self.app(scope, receive, send)
+        headers = dict(scope["headers"])
+        length = headers.get(b"content-length", b"0")
+        if not length.isdigit() or int(length) > self.max_bytes:
+            return await self._refuse(scope, receive, send)
+        seen = 0
+
+        async def limited():
+            nonlocal seen
+            message = await receive()
+            seen += len(message.get("body", b""))
+            if seen > self.max_bytes:
+                raise _TooLarge
+            return message
+
+        try:
+            await self.app(scope, limited, send)
+        except _TooLarge:
+            await self._refuse(scope, receive, send)
+
+    async def _refuse(self, scope, receive, send) -> None:
+        mb = self.max_bytes / 1024 / 1024
+        response = JSONResponse({"detail": f"request body above the limit of {mb:.1f} MB "
+                                           "(see --max-upload-mb)"}, status_code=413)
+        await response(scope, receive, send)
+
+
+class _TooLarge(Exception):
+    pass
+
+
+def create_app(settings: ServerSettings) -> FastAPI:
+    """The API app; the store and the worker pool live from its startup to its shutdown."""
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI):
+        store = Store(settings.data_dir / DATABASE)
+        planning = Planning(store, settings.max_plan_s, settings.workers)
+        app.state.store, app.state.planning = store, planning
+        try:
+            yield
+        finally:
+            await planning.shutdown()
+            store.close()
+
+    app = FastAPI(
+        title="Trackstar",
+        version=version("trackstar"),
+        description="Tracks, scenarios, RRT/RRT* plans and batch jobs for car-like robots.",
+        lifespan=lifespan,
+    )
+    app.state.settings = settings
+    app.add_middleware(BodyLimit, max_bytes=settings.max_upload_bytes + MULTIPART_SLACK)
+
+    @app.exception_handler(RequestValidationError)
+    async def invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
+        # Without the echoed input: it may hold NaN or infinity, which JSON cannot carry.
+        errors = [{"loc": e["loc"], "msg": e["msg"], "type": e["type"]} for e in exc.errors()]
+        return JSONResponse({"detail": errors}, status_code=422)
+
+    @app.exception_handler(ScenarioError)
+    async def unplannable(request: Request, exc: ScenarioError) -> JSONResponse:
+        return JSONResponse({"detail": str(exc)}, status_code=422)
+
+    @app.get("/health", response_model=Health, tags=["server"])
+    def health() -> Health:
+        return Health(status="ok", version=app.version, ui_port=settings.ui_port)
+
+    @app.get("/", include_in_schema=False)
+    def landing() -> FileResponse:
+        return FileResponse(STATIC / "index.html")
+
+    app.mount("/static", StaticFiles(directory=STATIC), name="static")
+    for module in (routes_tracks, routes_scenarios, routes_plan, routes_jobs):
+        app.include_router(module.router, prefix="/api/v1")
+    return app

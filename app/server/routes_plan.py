@@ -1,0 +1,33 @@
+"""POST /plan: one plan in a worker process, answered with the `trackstar plan --json` object."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, HTTPException, Request
+
+from app.planning import PlanOptions
+from app.server.models import PlanRequest
+from app.server.routes_scenarios import resolve
+from planner.report import PlanReport
+
+router = APIRouter(tags=["planning"])
+
+
+def plan_options(request: Request, body: PlanOptions, **override) -> PlanOptions:
+    """The planner options of a request body, checked against the server's time cap (422)."""
+    fields = body.model_dump(include=set(PlanOptions.model_fields)) | override
+    options = PlanOptions.model_validate(fields)
+    try:
+        options.time_budget(request.app.state.settings.max_plan_s)
+    except ValueError as exc:
+        raise HTTPException(422, str(exc)) from None
+    return options
+
+
+@router.post("/plan", response_model=PlanReport)
+async def plan(request: Request, body: PlanRequest) -> PlanReport:
+    """Plan one scenario (inline or by id) with the options of `trackstar plan`; the time
+    budget is capped by the server's --max-plan-s."""
+    options = plan_options(request, body)
+    scenario, track = resolve(
+        request, body.scenario if body.scenario is not None else body.scenario_id)
+    return await request.app.state.planning.plan(scenario, options, track)

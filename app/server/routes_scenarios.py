@@ -1,0 +1,65 @@
+"""/scenarios: stored planning problems, and the one way any route resolves a scenario."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from fastapi import APIRouter, HTTPException, Request, Response
+
+import planner
+import tracks
+from app.planning import TrackSource
+from app.server.models import ScenarioRecord
+
+router = APIRouter(tags=["scenarios"])
+
+
+def stored_scenario(request: Request, scenario_id: str) -> dict:
+    record = request.app.state.store.scenario(scenario_id)
+    if record is None:
+        raise HTTPException(404, f"no scenario {scenario_id!r} (GET /api/v1/scenarios lists them)")
+    return record
+
+
+def resolve(request: Request, body: dict[str, Any] | str) -> tuple[dict, TrackSource | None]:
+    """A scenario (inline or a stored id) validated, with the uploaded track it names if any.
+
+    Raises ScenarioError (→ 422) naming the field, or 404 for an unknown scenario id.
+    """
+    if isinstance(body, str):
+        body = stored_scenario(request, body)["scenario"]
+    scenario = planner.parse_scenario(body)
+    if scenario.track is None or scenario.track.name in tracks.library_names():
+        return body, None
+    row = request.app.state.store.track(scenario.track.name)
+    if row is None:
+        raise planner.ScenarioError(f"track.name: no track {scenario.track.name!r}: give a "
+                                    f"library name or an uploaded track's id")
+    return body, TrackSource(id=row["id"], svg=row["svg"], path=row["path"], unit=row["unit"])
+
+
+@router.post("/scenarios", response_model=ScenarioRecord, status_code=201)
+async def create_scenario(request: Request, scenario: dict[str, Any]) -> ScenarioRecord:
+    """Store a scenario (FORMAT.md or the rich schema) once it is known to be plannable: valid
+    fields, start and goal free. Its track may be a library name or an uploaded track's id."""
+    body, track = resolve(request, scenario)
+    await request.app.state.planning.check(body, track)
+    scenario_id = request.app.state.store.add_scenario(body["name"], body)
+    return ScenarioRecord(id=scenario_id, name=body["name"], scenario=body)
+
+
+@router.get("/scenarios", response_model=list[ScenarioRecord])
+def list_scenarios(request: Request) -> list[dict]:
+    return request.app.state.store.scenarios()
+
+
+@router.get("/scenarios/{scenario_id}", response_model=ScenarioRecord)
+def get_scenario(request: Request, scenario_id: str) -> dict:
+    return stored_scenario(request, scenario_id)
+
+
+@router.delete("/scenarios/{scenario_id}", status_code=204)
+def delete_scenario(request: Request, scenario_id: str) -> Response:
+    if not request.app.state.store.delete_scenario(scenario_id):
+        raise HTTPException(404, f"no scenario {scenario_id!r}")
+    return Response(status_code=204)

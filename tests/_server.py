@@ -1,0 +1,72 @@
+"""A real `trackstar serve` subprocess for the server tests: started on free ports, stopped
+by signal, with its start lines parsed for the real ports."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import httpx
+
+START_TIMEOUT_S = 60  # cold worker start on a loaded 2-core runner; normally ~2 s
+
+
+class Server:
+    def __init__(self, data_dir: Path, *args: str, env: dict | None = None,
+                 command: list[str] | None = None) -> None:
+        cmd = command or ["trackstar", "serve", "--port", "0", "--ui-port", "0",
+                          "--data-dir", str(data_dir), *args]
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     text=True, env={**os.environ, **(env or {})})
+        self.lines: list[str] = []
+        self.err: list[str] = []
+        started = threading.Event()
+
+        def read(stream, sink):
+            for line in stream:
+                sink.append(line.rstrip("\n"))
+                if line.startswith("UI: "):
+                    started.set()
+            started.set()  # the process ended
+
+        threading.Thread(target=read, args=(self.proc.stdout, self.lines), daemon=True).start()
+        threading.Thread(target=read, args=(self.proc.stderr, self.err), daemon=True).start()
+        if not started.wait(START_TIMEOUT_S) or self.proc.poll() is not None:
+            self.stop()
+            raise RuntimeError(f"server did not start: {self.lines} {self.err}")
+        api = next(m for line in self.lines if (m := re.fullmatch(r"API: http://(.+):(\d+)/docs",
+                                                                  line)))
+        ui = next(m for line in self.lines if (m := re.fullmatch(r"UI: http://(.+):(\d+)/",
+                                                                 line)))
+        self.port, self.ui_port = int(api[2]), int(ui[2])
+        self.url = f"http://127.0.0.1:{self.port}"
+        self.client = httpx.Client(base_url=self.url + "/api/v1", timeout=60)
+
+    def get(self, path: str, **kw) -> httpx.Response:
+        return httpx.get(self.url + path, timeout=60, **kw)
+
+    def stop(self, sig: int = signal.SIGTERM) -> float:
+        """Signal the server and wait for it; returns the seconds it took to exit."""
+        start = time.monotonic()
+        if self.proc.poll() is None:
+            self.proc.send_signal(sig)
+            try:
+                self.proc.wait(20)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        return time.monotonic() - start
+
+    def wait_job(self, job_id: str, timeout: float = 60) -> dict:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            job = self.client.get(f"/jobs/{job_id}").json()
+            if job["status"] not in ("queued", "running"):
+                return job
+            time.sleep(0.1)
+        raise TimeoutError(f"job {job_id} still {job['status']} after {timeout} s")

@@ -1,0 +1,215 @@
+"""Every endpoint of the REST API and its error paths, over HTTP against `trackstar serve`."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import xml.etree.ElementTree as ET
+
+import pytest
+from _server import Server
+from conftest import SCENARIOS, scenario_dict
+
+import tracks
+
+SVG_NS = 'xmlns="http://www.w3.org/2000/svg" xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape"'
+# Two paths in a 100 mm × 50 mm document (1 user unit = 1 mm): a 60 mm square loop and a line.
+TWO_PATHS = (f'<svg {SVG_NS} width="100mm" height="50mm" viewBox="0 0 100 50">'
+             '<path id="loop" inkscape:label="Ring" d="M10 10 h30 v30 h-30 z" stroke-width="4"/>'
+             '<path id="road" d="M50 10 L90 10" stroke-width="2"/></svg>').encode()
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    srv = Server(tmp_path_factory.mktemp("data"), "--max-upload-mb", "0.05",
+                 "--max-plan-s", "3")
+    yield srv
+    srv.stop()
+
+
+def upload(server, data: bytes, filename="t.svg", **form):
+    return server.client.post("/tracks", files={"file": (filename, data, "image/svg+xml")},
+                              data=form)
+
+
+def test_health_landing_and_docs(server):
+    health = server.get("/health").json()
+    assert health == {"status": "ok", "version": "0.1.0", "ui_port": server.ui_port}
+    landing = server.get("/")
+    assert landing.status_code == 200 and 'href="/docs"' in landing.text
+    assert server.get("/docs").status_code == 200
+    paths = server.get("/openapi.json").json()["paths"]
+    for path in ("/api/v1/tracks", "/api/v1/tracks/{track_id}/profile", "/api/v1/plan",
+                 "/api/v1/jobs/{job_id}/results.csv", "/api/v1/scenarios/{scenario_id}"):
+        assert path in paths
+
+
+def test_library_tracks_come_first_and_match_the_tracks_package(server):
+    listed = server.client.get("/tracks").json()
+    names = tracks.library_names()
+    assert [t["id"] for t in listed[:len(names)]] == names
+    thesis = next(t for t in listed if t["id"] == "thesis")
+    assert thesis["source"] == "library" and thesis["closed"]
+    assert thesis["length_m"] == pytest.approx(tracks.load_library_track("thesis").length_m)
+
+
+def test_upload_lists_every_path_and_serves_geometry(server):
+    resp = upload(server, TWO_PATHS, path="Ring")
+    assert resp.status_code == 201, resp.text
+    track = resp.json()
+    assert track["source"] == "upload" and track["closed"] and track["name"] == "Ring"
+    assert track["length_m"] == pytest.approx(0.12) and track["width_m"] == pytest.approx(0.004)
+    assert track in server.client.get("/tracks").json()
+
+    paths = server.client.get(f"/tracks/{track['id']}/paths").json()
+    assert [(p["id"], p["label"]) for p in paths["paths"]] == [("loop", "Ring"), ("road", None)]
+    assert paths["unit_m"] == pytest.approx(0.001)
+
+    geo = server.client.get(f"/tracks/{track['id']}").json()
+    centre = geo["centerline"]
+    xs, ys = [p[0] for p in centre], [p[1] for p in centre]
+    # World frame: x = 1 mm · svg_x, y = −1 mm · svg_y.
+    assert min(xs) == pytest.approx(0.01) and max(xs) == pytest.approx(0.04)
+    assert max(ys) == pytest.approx(-0.01) and min(ys) == pytest.approx(-0.04)
+    assert len(geo["left"]) == len(geo["right"]) == len(centre)
+    for (lx, ly), (rx, ry) in zip(geo["left"], geo["right"]):
+        assert ((lx - rx) ** 2 + (ly - ry) ** 2) ** 0.5 == pytest.approx(0.004)
+
+
+def test_profile_is_the_track_sample_json_object(server, tmp_path):
+    got = server.client.get("/tracks/carolo/profile",
+                            params={"spacing": 0.1, "wheelbase": 0.3, "max_steer_deg": 20})
+    cli = subprocess.run(["trackstar", "track", "sample", "carolo", "--json", "--spacing", "0.1",
+                          "--wheelbase", "0.3", "--max-steer-deg", "20"],
+                         capture_output=True, text=True, check=True)
+    assert got.json() == json.loads(cli.stdout)
+    assert server.client.get("/tracks/carolo/profile", params={"spacing": -1}).status_code == 422
+    too_fine = server.client.get("/tracks/carolo/profile", params={"spacing": 1e-7})
+    assert too_fine.status_code == 422 and "points" in too_fine.json()["detail"]
+
+
+def test_svg_export_round_trips(server, tmp_path):
+    resp = server.client.get("/tracks/thesis/svg")
+    assert resp.headers["content-type"].startswith("image/svg+xml")
+    ET.fromstring(resp.content)
+    again = tracks.load_svg(resp.content)
+    assert again.length_m == pytest.approx(tracks.load_library_track("thesis").length_m, rel=1e-6)
+
+
+def test_delete_upload_but_not_library(server):
+    track_id = upload(server, TWO_PATHS).json()["id"]
+    assert server.client.delete(f"/tracks/{track_id}").status_code == 204
+    assert server.client.get(f"/tracks/{track_id}").status_code == 404
+    assert server.client.delete(f"/tracks/{track_id}").status_code == 404
+    assert server.client.delete("/tracks/thesis").status_code == 403
+
+
+@pytest.mark.parametrize("data, status, words", [
+    (b"hello", 400, "malformed XML"),
+    (b"<html><body/></html>", 400, "not an SVG"),
+    ((b'<?xml version="1.0"?><!DOCTYPE lolz [<!ENTITY lol "lol"><!ENTITY lol2 "&lol;&lol;">]>'
+     b'<svg xmlns="http://www.w3.org/2000/svg"><text>&lol2;</text></svg>'), 400, "unsafe XML"),
+    ((b'<?xml version="1.0"?><!DOCTYPE svg [<!ENTITY x SYSTEM "file:///etc/passwd">]>'
+     b'<svg xmlns="http://www.w3.org/2000/svg"><text>&x;</text></svg>'), 400, "unsafe XML"),
+    (f'<svg {SVG_NS}><text>no paths</text></svg>'.encode(), 400, "no path"),
+    (f'<svg {SVG_NS}><path d="M0 0 {"l1 1 " * 10_001}"/></svg>'.encode(), 400, "segments"),
+    (b"<svg " + b"x" * 60_000 + b"/>", 413, "limit"),
+])
+def test_bad_uploads_are_refused_with_a_message(server, data, status, words):
+    resp = upload(server, data)
+    assert resp.status_code == status and words in resp.json()["detail"]
+
+
+def test_upload_options_are_checked(server):
+    unknown = upload(server, TWO_PATHS, path="nope")
+    assert unknown.status_code == 400 and "'nope'" in unknown.json()["detail"]
+    assert "loop" in unknown.json()["detail"]  # it lists what is available
+    assert upload(server, TWO_PATHS, unit="furlong").status_code == 400
+    km = upload(server, TWO_PATHS, unit="m")  # a 120 m loop: fine
+    assert km.status_code == 201 and km.json()["length_m"] == pytest.approx(120)
+    assert server.client.post("/tracks").status_code == 422  # no file
+
+
+def test_unknown_ids_are_404(server):
+    for path in ("/tracks/nope", "/tracks/nope/paths", "/tracks/nope/profile", "/tracks/nope/svg",
+                 "/scenarios/nope", "/jobs/nope", "/jobs/nope/results.csv"):
+        resp = server.client.get(path)
+        assert resp.status_code == 404 and "nope" in resp.json()["detail"], path
+    assert server.client.post("/plan", json={"scenario_id": "nope"}).status_code == 404
+
+
+def test_scenarios_crud(server):
+    body = scenario_dict("slalom")
+    created = server.client.post("/scenarios", json=body)
+    assert created.status_code == 201
+    record = created.json()
+    assert record["name"] == "slalom" and record["scenario"] == body
+    assert server.client.get(f"/scenarios/{record['id']}").json() == record
+    assert record in server.client.get("/scenarios").json()
+    assert server.client.delete(f"/scenarios/{record['id']}").status_code == 204
+    assert server.client.get(f"/scenarios/{record['id']}").status_code == 404
+
+
+def _broken(change) -> dict:
+    body = scenario_dict("open_field")
+    change(body)
+    return body
+
+
+@pytest.mark.parametrize("body, words", [
+    (_broken(lambda b: b.update(start=[b["obstacles"][0]["center"][0],
+                                       b["obstacles"][0]["center"][1], 0])), "start"),
+    (_broken(lambda b: b["obstacles"][0].update(radius=-1)), "obstacles[0].radius"),
+    (_broken(lambda b: b["vehicle"].update(wheelbase=float("nan"))), "vehicle.wheelbase"),
+    (_broken(lambda b: b.update(obstacle=[])), "did you mean 'obstacles'"),
+    (_broken(lambda b: b.update(track={"name": "nowhere"})), "nowhere"),
+    ([1, 2], "valid dictionary"),
+])
+def test_bad_scenarios_are_422_naming_the_field(server, body, words):
+    text = json.dumps(body)  # NaN goes over the wire as the JSON extension NaN
+    for path, wrap in (("/scenarios", body), ("/plan", {"scenario": body})):
+        resp = server.client.post(path, content=json.dumps(wrap) if path == "/plan" else text,
+                                  headers={"content-type": "application/json"})
+        assert resp.status_code == 422, (path, resp.text)
+        assert words in json.dumps(resp.json()["detail"]), (path, resp.text)
+
+
+def test_plan_is_the_cli_plan_json(server):
+    options = {"iterations": 800, "seed": 3, "planner": "rrt"}
+    got = server.client.post("/plan", json={"scenario": scenario_dict("open_field"), **options})
+    assert got.status_code == 200, got.text
+    cli = subprocess.run(["trackstar", "plan", str(SCENARIOS / "open_field.json"), "--json",
+                          "--iterations", "800", "--seed", "3", "--planner", "rrt"],
+                         capture_output=True, text=True, check=True)
+    report, expected = got.json(), json.loads(cli.stdout)
+    assert report.keys() == expected.keys()
+    assert report["path"] == expected["path"] and report["cost"] == expected["cost"]
+    assert report["parameters"]["time"] == 3  # iterations only: the server's cap still holds
+
+
+def test_plan_by_id_on_an_uploaded_track(server):
+    track = upload(server, TWO_PATHS, path="loop", unit="m").json()  # 30 m square, 4 m wide
+    scenario = {"name": "square", "track": {"name": track["id"]},
+                "start": [15, -10, 0], "goal": [40, -25, -1.5708]}
+    created = server.client.post("/scenarios", json=scenario)
+    assert created.status_code == 201, created.text
+    report = server.client.post("/plan", json={"scenario_id": created.json()["id"],
+                                               "time": 1}).json()
+    assert report["scenario"] == "square" and report["solved"]
+    for x, y, _ in report["path"]:  # inside the 4 m band around the square's centreline
+        near_edge = min(abs(x - 10), abs(x - 40), abs(y + 10), abs(y + 40))
+        assert near_edge <= 2.0 + 1e-6
+
+
+@pytest.mark.parametrize("body, words", [
+    ({"scenario_id": "x", "scenario": {}}, "exactly one"),
+    ({}, "exactly one"),
+    ({"scenario": {}, "time": 10}, "limit of 3"),
+    ({"scenario": {}, "time": -1}, "greater than 0"),
+    ({"scenario": {}, "planner": "prm"}, "rrtstar"),
+    ({"scenario": {}, "goal_bias": 1.5}, "less than 1"),
+    ({"scenario": {}, "colour": "red"}, "colour"),
+])
+def test_bad_plan_options_are_422(server, body, words):
+    resp = server.client.post("/plan", json=body)
+    assert resp.status_code == 422 and words in json.dumps(resp.json()["detail"]), resp.text

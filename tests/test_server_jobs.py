@@ -1,0 +1,97 @@
+"""Batch jobs over HTTP: progress, results, CSV export, cancellation, failures, responsiveness."""
+
+from __future__ import annotations
+
+import csv
+import io
+import time
+
+import pytest
+from _server import Server
+from conftest import scenario_dict
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    srv = Server(tmp_path_factory.mktemp("data"))
+    yield srv
+    srv.stop()
+
+
+def test_job_runs_every_combination(server):
+    stored = server.client.post("/scenarios", json=scenario_dict("slalom")).json()["id"]
+    body = {"scenarios": [stored, scenario_dict("open_field")],
+            "parameters": [{"iterations": 300}, {"iterations": 300, "planner": "rrt"}],
+            "seeds": [0, 1]}
+    created = server.client.post("/jobs", json=body)
+    assert created.status_code == 202 and created.json()["total"] == 8
+    job = server.wait_job(created.json()["id"])
+    assert job["status"] == "done" and job["done"] == job["total"] == 8
+    runs = {(r["scenario"], r["parameters"]["algorithm"], r["seed"]) for r in job["results"]}
+    assert runs == {(s, a, seed) for s in ("slalom", "open_field") for a in ("rrtstar", "rrt")
+                    for seed in (0, 1)}
+    assert all("path" not in r and r["iterations"] >= 1 for r in job["results"])
+    # A job's run is the same plan as POST /plan with those options.
+    single = server.client.post("/plan", json={"scenario_id": stored, "iterations": 300,
+                                               "seed": 1}).json()
+    twin = next(r for r in job["results"] if r["scenario"] == "slalom" and r["seed"] == 1
+                and r["parameters"]["algorithm"] == "rrtstar")
+    assert twin["cost"] == single["cost"] and twin["nodes"] == single["nodes"]
+
+    table = server.client.get(f"/jobs/{job['id']}/results.csv")
+    assert table.headers["content-type"].startswith("text/csv")
+    rows = list(csv.DictReader(io.StringIO(table.text)))
+    assert len(rows) == 8
+    assert {"scenario", "seed", "cost", "solved", "parameters.algorithm"} <= rows[0].keys()
+    assert {r["parameters.algorithm"] for r in rows} == {"rrt", "rrtstar"}
+
+
+def test_cancel_keeps_finished_results_and_stays_cancelled(server):
+    body = {"scenarios": [scenario_dict("slalom")], "parameters": [{"time": 0.5}],
+            "seeds": list(range(40))}
+    job_id = server.client.post("/jobs", json=body).json()["id"]
+    time.sleep(1.2)
+    cancelled = server.client.delete(f"/jobs/{job_id}").json()
+    assert cancelled["status"] == "cancelled" and cancelled["done"] < 40
+    time.sleep(0.8)  # runs that were in the pool finish; they are not counted in
+    job = server.client.get(f"/jobs/{job_id}").json()
+    assert job["status"] == "cancelled" and job["done"] <= cancelled["done"] + 2
+    done = server.wait_job(server.client.post("/jobs", json={
+        "scenarios": [scenario_dict("slalom")], "parameters": [{"iterations": 50}]}).json()["id"])
+    assert server.client.delete(f"/jobs/{done['id']}").json()["status"] == "done"
+
+
+def test_unplannable_run_fails_the_job_with_the_reason(server):
+    walled = scenario_dict("open_field")
+    walled["start"] = [*walled["obstacles"][0]["center"], 0]
+    job = server.wait_job(server.client.post("/jobs", json={"scenarios": [walled]}).json()["id"])
+    assert job["status"] == "failed" and "in collision" in job["error"]
+
+
+@pytest.mark.parametrize("body, status, words", [
+    ({"scenarios": []}, 422, "at least 1"),
+    ({"scenarios": ["nope"]}, 404, "nope"),
+    ({"scenarios": [{"name": "x"}]}, 422, "scenarios[0]: invalid scenario: start"),
+    ({"scenarios": [scenario_dict("slalom")], "parameters": [{"seed": 3}]}, 422, "seeds"),
+    ({"scenarios": [scenario_dict("slalom")], "parameters": [{"time": 1e9}]}, 422, "limit"),
+    ({"scenarios": [scenario_dict("slalom")], "seeds": list(range(10_001))}, 422, "at most"),
+])
+def test_bad_jobs_are_refused(server, body, status, words):
+    resp = server.client.post("/jobs", json=body)
+    assert resp.status_code == status and words in str(resp.json()["detail"]), resp.text
+
+
+def test_server_answers_while_the_pool_is_busy(server):
+    body = {"scenarios": [scenario_dict("slalom")], "parameters": [{"time": 1.0}],
+            "seeds": list(range(8))}
+    job_id = server.client.post("/jobs", json=body).json()["id"]
+    time.sleep(0.3)
+    slowest = 0.0
+    for _ in range(20):
+        start = time.monotonic()
+        assert server.get("/health").status_code == 200
+        slowest = max(slowest, time.monotonic() - start)
+        time.sleep(0.05)
+    assert server.client.get(f"/jobs/{job_id}").json()["status"] == "running"
+    assert slowest < 0.5
+    server.client.delete(f"/jobs/{job_id}")

@@ -1,0 +1,113 @@
+"""`trackstar serve` as a process: ports, environment, restarts, shutdown, the Docker CMD."""
+
+from __future__ import annotations
+
+import json
+import re
+import signal
+import socket
+import subprocess
+import time
+from pathlib import Path
+
+import httpx
+import pytest
+from _server import Server
+from conftest import scenario_dict
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_data_survive_a_restart_and_an_interrupted_job_is_marked(tmp_path):
+    first = Server(tmp_path)
+    track = first.client.post("/tracks", files={"file": ("ring.svg", (ROOT / "tracks" / "library"
+                                                                       / "thesis.svg").read_bytes())})
+    scenario = first.client.post("/scenarios", json=scenario_dict("slalom")).json()
+    finished = first.wait_job(first.client.post("/jobs", json={
+        "scenarios": [scenario["id"]], "parameters": [{"iterations": 100}]}).json()["id"])
+    running = first.client.post("/jobs", json={"scenarios": [scenario["id"]],
+                                               "parameters": [{"time": 3}],
+                                               "seeds": list(range(10))}).json()
+    time.sleep(1.0)
+    assert first.client.get(f"/jobs/{running['id']}").json()["status"] == "running"
+    took = first.stop(signal.SIGTERM)
+    assert first.proc.returncode == 0 and took < 5, (took, first.err)
+
+    second = Server(tmp_path)
+    try:
+        assert track.json() in second.client.get("/tracks").json()
+        assert second.client.get(f"/scenarios/{scenario['id']}").json() == scenario
+        assert second.client.get(f"/jobs/{finished['id']}").json() == finished
+        interrupted = second.client.get(f"/jobs/{running['id']}").json()
+        assert interrupted["status"] == "failed" and "shutdown" in interrupted["error"]
+        assert interrupted["done"] < interrupted["total"]
+    finally:
+        assert second.stop(signal.SIGINT) < 5
+
+
+def test_a_crash_mid_job_is_marked_after_restart(tmp_path):
+    first = Server(tmp_path)
+    job = first.client.post("/jobs", json={"scenarios": [scenario_dict("slalom")],
+                                           "parameters": [{"time": 3}]}).json()
+    time.sleep(0.5)
+    first.stop(signal.SIGKILL)
+    second = Server(tmp_path)
+    try:
+        job = second.client.get(f"/jobs/{job['id']}").json()
+        assert job["status"] == "failed" and "interrupted" in job["error"]
+    finally:
+        second.stop()
+
+
+@pytest.mark.parametrize("flag", ["--port", "--ui-port"])
+def test_a_busy_port_is_an_error_naming_it(tmp_path, flag):
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        other = "--ui-port" if flag == "--port" else "--port"
+        out = subprocess.run(["trackstar", "serve", flag, str(port), other, "0",
+                              "--data-dir", str(tmp_path)],
+                             capture_output=True, text=True, timeout=60, check=False)
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and str(port) in lines[0] and lines[0].startswith("error:")
+
+
+def test_ports_and_data_dir_from_the_environment(tmp_path):
+    port, ui_port = free_port(), free_port()
+    srv = Server(tmp_path, command=["trackstar", "serve"],
+                 env={"TRACKSTAR_PORT": str(port), "TRACKSTAR_UI_PORT": str(ui_port),
+                      "TRACKSTAR_DATA_DIR": str(tmp_path / "env-data")})
+    try:
+        assert (srv.port, srv.ui_port) == (port, ui_port)
+        assert srv.lines[-2:] == [f"API: http://127.0.0.1:{port}/docs",
+                                  f"UI: http://127.0.0.1:{ui_port}/"]
+        assert (tmp_path / "env-data" / "trackstar.sqlite3").is_file()
+        assert httpx.get(f"http://127.0.0.1:{ui_port}/", timeout=10).status_code == 200
+    finally:
+        srv.stop()
+
+
+def test_the_dockerfile_cmd_serves_health(tmp_path):
+    text = (ROOT / "Dockerfile").read_text()
+    cmd = json.loads(re.search(r"^CMD (\[.*\])$", text, re.MULTILINE)[1])
+    assert cmd == ["trackstar", "serve", "--host", "0.0.0.0"]
+    assert re.search(r"^USER (?!root)", text, re.MULTILINE) and "HEALTHCHECK" in text
+    port, ui_port = free_port(), free_port()
+    srv = Server(tmp_path, command=cmd, env={"TRACKSTAR_PORT": str(port),
+                                             "TRACKSTAR_UI_PORT": str(ui_port),
+                                             "TRACKSTAR_DATA_DIR": str(tmp_path)})
+    try:
+        assert srv.lines[-1] == f"UI: http://0.0.0.0:{ui_port}/"
+        assert any("no authentication" in line for line in srv.err)
+        health = srv.get("/health").json()
+        assert health["status"] == "ok" and health["ui_port"] == ui_port
+    finally:
+        assert srv.stop() < 5
