@@ -57,7 +57,7 @@ class Chain:
         out = []
         for k in range(self.count):
             roots: list[float] = []
-            if not self.is_arc[k]:
+            if not self.is_arc[k] and np.isfinite(self.first[k]).all():
                 for c in range(2):
                     p0, p1, p2 = self.first[k, :, c]
                     roots += [r.real for r in np.roots([p0 - 2 * p1 + p2, 2 * (p1 - p0), p0])

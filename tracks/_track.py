@@ -52,6 +52,8 @@ class Track:
         _positive("width", self.width_m)
         chain = Chain(self.segments)
         table = length_table(chain.velocity, chain.count, breaks=chain.kinks())
+        if not np.isfinite(table.length):
+            raise TrackError(f"track {self.name!r} has non-finite geometry (a degenerate arc?)")
         keep = table.segment_lengths(chain.count) > 1e-12 * table.length
         if not keep.any():
             raise TrackError(f"track {self.name!r} has zero length")
