@@ -6,7 +6,8 @@ ports are known free, and calls `stop()` on the returned handle at shutdown.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import threading
+from dataclasses import dataclass, field
 
 import viser
 
@@ -19,14 +20,43 @@ class StudioHandle:
 
     server: viser.ViserServer
     port: int
+    sessions: dict = field(default_factory=dict)
 
     def stop(self) -> None:
+        for session in list(self.sessions.values()):
+            session.close()
         self.server.stop()
 
 
 def launch(host: str, port: int, api_url: str) -> StudioHandle:
     """Start the studio's viser server on (host, port); ``api_url`` is the REST API's base URL
     (for saving and loading scenarios through the server's store)."""
+    from app.studio._session import Session
+    from planner.rrt import warm_up
+
+    warm_up()  # compiled kernels from numba's cache, before the first tab waits for them
     server = viser.ViserServer(host=host, port=port, verbose=False)
-    server.gui.add_markdown("**Trackstar studio** — tracks, obstacles and RRT* live.")
-    return StudioHandle(server=server, port=server.get_port())
+    server.gui.configure_theme(control_width="large", show_share_button=False)
+    server.scene.world_axes.visible = False
+    handle = StudioHandle(server=server, port=server.get_port())
+    lock = threading.Lock()
+
+    def _open(client: viser.ClientHandle) -> None:
+        session = Session(client, api_url)
+        with lock:
+            handle.sessions[client.client_id] = session
+
+    @server.on_client_connect
+    def _connect(client: viser.ClientHandle) -> None:
+        # Off the event loop: building a session (track, meshes, a planner) takes a moment and
+        # other tabs must not wait for it.
+        threading.Thread(target=_open, args=(client,), daemon=True, name="studio-open").start()
+
+    @server.on_client_disconnect
+    def _disconnect(client: viser.ClientHandle) -> None:
+        with lock:
+            session = handle.sessions.pop(client.client_id, None)
+        if session is not None:
+            session.close()
+
+    return handle

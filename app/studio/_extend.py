@@ -1,0 +1,71 @@
+"""The teaching view's text: RRT*'s EXTEND with the line one iteration ended on highlighted.
+
+The line is chosen from the kernel's event record of that iteration, so the panel explains what
+the planner really did (rejected sample, blocked steer, new node, rewires), not a replay.
+"""
+
+from __future__ import annotations
+
+import html
+from dataclasses import dataclass
+
+from planner import _kernel as K
+
+__all__ = ["LINES", "StepInfo", "explain", "render"]
+
+LINES = (
+    "x_rand ← SampleFree()",
+    "x_nearest ← Nearest(T, x_rand)",
+    "x_new ← Steer(x_nearest, x_rand)   ▹ at most ε",
+    "if ObstacleFree(x_nearest, x_new):",
+    "    X_near ← Near(T, x_new, r)",
+    "    x_min ← argmin Cost(x) + c(x, x_new) over free x ∈ X_near",
+    "    T.add(x_new, parent = x_min)",
+    "    for x ∈ X_near cheaper through x_new: Rewire(x → x_new)",
+    "return T",
+)
+
+
+@dataclass(frozen=True)
+class StepInfo:
+    """One iteration as the kernel recorded it (-1: did not happen)."""
+
+    iteration: int
+    nearest: int
+    new: int
+    parent: int
+    n_near: int
+    n_rewired: int
+    radius: float
+
+    @classmethod
+    def from_row(cls, row, n_rewired: int) -> StepInfo:
+        return cls(int(row[K.EV_ITER]), int(row[K.EV_NEAREST]), int(row[K.EV_NEW]),
+                   int(row[K.EV_PARENT]), max(int(row[K.EV_NEAR_END] - row[K.EV_NEAR_START]), 0),
+                   n_rewired, float(row[K.EV_RADIUS]))
+
+
+def explain(info: StepInfo, star: bool) -> tuple[int, str]:
+    """(index into LINES of the line the iteration ended on, a one-line explanation)."""
+    if info.nearest < 0:
+        return 0, "x_rand fell inside an obstacle: SampleFree rejects it (the iteration counts)."
+    if info.new < 0:
+        return 3, (f"The path from x_nearest (#{info.nearest}) to x_new is blocked"
+                   + (" and no near node reaches it" if star else "") + ": no node added.")
+    if not star:
+        return 6, f"x_new (#{info.new}) added with parent x_nearest (#{info.parent})."
+    if info.n_rewired:
+        return 7, (f"x_new (#{info.new}) joined via x_min (#{info.parent}); {info.n_rewired} of "
+                   f"{info.n_near} near nodes got cheaper through it and were rewired.")
+    return 6, (f"x_new (#{info.new}) joined via x_min (#{info.parent}), the cheapest of "
+               f"{info.n_near} near nodes (r = {info.radius:.2f} m); none got cheaper.")
+
+
+def render(line: int | None, note: str) -> str:
+    """The panel's HTML: numbered pseudocode, the current line in a <mark>, the note below."""
+    rows = []
+    for i, text in enumerate(LINES):
+        code = f"{i + 1:>2}  {html.escape(text)}"
+        rows.append(f"<mark>{code}</mark>" if i == line else code)
+    return ("<pre style='font-size:11px;line-height:1.5;margin:0;white-space:pre-wrap'>"
+            + "\n".join(rows) + f"</pre><p style='font-size:12px'>{html.escape(note)}</p>")

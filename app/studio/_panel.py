@@ -1,0 +1,111 @@
+"""The session's GUI controls, built once per browser tab (labels are what tests click)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import tracks
+from app.studio._extend import render
+
+__all__ = ["ALGORITHMS", "SPEEDS", "STEERINGS", "Panel", "build_panel"]
+
+ALGORITHMS = {"RRT*": "rrtstar", "RRT": "rrt"}
+STEERINGS = {"Dubins": "dubins", "Reeds-Shepp": "reeds-shepp"}
+SPEEDS = {"max": None, "2000 it/s": 2000.0, "200 it/s": 200.0, "20 it/s": 20.0}
+
+
+@dataclass
+class Panel:
+    """Handles of every control a session reads or wires up."""
+
+    track: object
+    svg_upload: object
+    svg_path: object
+    fit: object
+    draw: object
+    draw_width: object
+    draw_close: object
+    draw_undo: object
+    draw_use: object
+    draw_download: object
+    add_circle: object
+    add_box: object
+    clear_obstacles: object
+    velocity: object
+    scene_time: object
+    play: object
+    scenario_download: object
+    scenario_upload: object
+    scenario_save: object
+    scenario_load: object
+    scenario_name: object
+    algorithm: object
+    steering: object
+    eps: object
+    gamma: object
+    k_rrt: object
+    goal_bias: object
+    budget: object
+    seed: object
+    speed_v: object
+    rate: object
+    run: object
+    pause: object
+    step: object
+    reset: object
+    drive: object
+    status: object
+    metrics: object
+    extend: object
+    plots: object
+
+
+def build_panel(gui) -> Panel:
+    with gui.add_folder("Track"):
+        track = gui.add_dropdown("Track", tuple(tracks.library_names()), initial_value="thesis")
+        svg_upload = gui.add_upload_button("Upload SVG", mime_type=".svg,image/svg+xml")
+        svg_path = gui.add_dropdown("SVG path", ("—",), visible=False)
+        fit = gui.add_button("Fit view")
+    with gui.add_folder("Draw a track", expand_by_default=False):
+        draw = gui.add_checkbox("Draw (click the ground)", False)
+        draw_width = gui.add_number("Width (m)", 0.6, min=0.1, max=10.0, step=0.05)
+        draw_close = gui.add_checkbox("Closed loop", True)
+        draw_undo = gui.add_button("Undo point")
+        draw_use = gui.add_button("Use drawn track")
+        draw_download = gui.add_button("Download track SVG")
+    with gui.add_folder("Obstacles"):
+        add_circle = gui.add_button("Add circle")
+        add_box = gui.add_button("Add box")
+        clear_obstacles = gui.add_button("Clear obstacles")
+        velocity = gui.add_vector2("Velocity of new (m/s)", (0.0, 0.0), step=0.05)
+        scene_time = gui.add_slider("Scene time (s)", 0.0, 30.0, 0.1, 0.0)
+        play = gui.add_checkbox("Play scene time", False)
+    with gui.add_folder("Scenario", expand_by_default=False):
+        scenario_name = gui.add_text("Name", "studio")
+        scenario_download = gui.add_button("Download scenario (JSON)")
+        scenario_upload = gui.add_upload_button("Upload scenario (JSON)", mime_type=".json")
+        scenario_save = gui.add_button("Save to server")
+        scenario_load = gui.add_button("Load from server")
+    with gui.add_folder("Planner"):
+        algorithm = gui.add_dropdown("Algorithm", tuple(ALGORITHMS), initial_value="RRT*")
+        steering = gui.add_dropdown("Steering", tuple(STEERINGS), initial_value="Dubins")
+        eps = gui.add_number("ε (m, 0 = auto)", 0.0, min=0.0, step=0.05)
+        gamma = gui.add_number("γ (0 = auto)", 0.0, min=0.0, step=0.5)
+        k_rrt = gui.add_number("k (0 = radius form)", 0.0, min=0.0, step=0.5)
+        goal_bias = gui.add_slider("Goal bias", 0.0, 0.5, 0.01, 0.05)
+        budget = gui.add_number("Budget (iterations)", 30000, min=1, step=1000)
+        seed = gui.add_number("Seed", 0, min=0, step=1)
+        speed_v = gui.add_number("v (m/s)", 1.0, min=0.05, step=0.1)
+        rate = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="max")
+        run = gui.add_button("Run")
+        pause = gui.add_button("Pause")
+        step = gui.add_button("Step")
+        reset = gui.add_button("Reset")
+        drive = gui.add_button("Drive car")
+        status = gui.add_markdown("Status: ready")
+    with gui.add_folder("Metrics"):
+        metrics = gui.add_markdown("—")
+    with gui.add_folder("EXTEND"):
+        extend = gui.add_html(render(None, "Press Step to run one iteration."))
+    plots = gui.add_folder("Profiles")
+    return Panel(**{k: v for k, v in locals().items() if k != "gui"})

@@ -1,0 +1,114 @@
+"""The tree as fixed-size chunks of edges: what to send the browser, and when.
+
+Each node owns the edge from its parent (a rewire changes only that edge), drawn as ``SEG``
+straight pieces along the car's curve. Node i lives in chunk i // CHUNK. The tail chunk (where
+new nodes land) is re-sent at UI rate; a full chunk is re-sent only when a rewire touched it, a
+few chunks per slow tick. So the bytes per second depend on the chunk size and the rates, never
+on the size of the tree.
+"""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+
+from planner._paths import sample_path
+
+__all__ = ["CHUNK", "SEG", "EdgeChunks", "edge_points"]
+
+SEG = 4  # straight pieces per edge
+CHUNK = 256  # nodes per chunk
+
+
+def edge_points(tree, node: int, rho: float, seg: int = SEG) -> np.ndarray:
+    """(seg + 1, 2) points along the car path from ``node``'s parent to it (the root: a dot).
+
+    Reads the planner's tree arrays, so call it on the planner's thread (from a listener).
+    """
+    parent = int(tree.parent[node])
+    if parent < 0:
+        return np.repeat(tree.pose[node:node + 1, :2], seg + 1, axis=0)
+    total = float(np.abs(tree.lens[node]).sum())
+    dense = sample_path(*tree.pose[parent], tree.kinds[node], tree.lens[node], rho,
+                        max(total / (4 * seg), 1e-6))
+    pick = np.linspace(0, len(dense) - 1, seg + 1).round().astype(int)
+    return dense[pick, :2]
+
+
+class EdgeChunks:
+    """Edges by node, with the bookkeeping of which chunks the browser has not seen yet.
+
+    Written by the planner's thread, read by the UI's; every method takes the lock.
+    """
+
+    def __init__(self, seg: int = SEG, chunk: int = CHUNK, capacity: int = 4096) -> None:
+        self.seg, self.chunk = seg, chunk
+        self._pts = np.zeros((capacity, seg + 1, 2), np.float32)
+        self._n = 0
+        self._tail_dirty = False
+        self._sent_n = 0  # nodes the browser had at the last tail push
+        self._dirty: dict[int, None] = {}  # full chunks touched by rewires, oldest first
+        self._lock = threading.Lock()
+
+    @property
+    def count(self) -> int:
+        return self._n
+
+    def get(self, node: int) -> np.ndarray:
+        with self._lock:
+            return self._pts[node].copy()
+
+    def set(self, node: int, pts: np.ndarray) -> None:
+        """Record node's edge (a new node, or a rewired one)."""
+        with self._lock:
+            if node >= len(self._pts):
+                grown = np.zeros((max(2 * len(self._pts), node + 1), *self._pts.shape[1:]),
+                                 np.float32)
+                grown[:len(self._pts)] = self._pts
+                self._pts = grown
+            self._pts[node] = pts
+            self._n = max(self._n, node + 1)
+            c = node // self.chunk
+            if c >= self._sent_n // self.chunk:
+                self._tail_dirty = True
+            else:
+                self._dirty[c] = None
+
+    def _tail_chunk(self) -> int:
+        return max(self._n - 1, 0) // self.chunk
+
+    def segments(self, c: int) -> np.ndarray:
+        """Chunk c as (m·seg, 2, 3) line segments at z = 0."""
+        with self._lock:
+            return self._segments(c)
+
+    def _segments(self, c: int) -> np.ndarray:
+        p = self._pts[c * self.chunk:min((c + 1) * self.chunk, self._n)]
+        seg = np.zeros((len(p), self.seg, 2, 3), np.float32)
+        seg[:, :, 0, :2] = p[:, :-1]
+        seg[:, :, 1, :2] = p[:, 1:]
+        return seg.reshape(-1, 2, 3)
+
+    def take_tail(self) -> list[tuple[int, np.ndarray]]:
+        """The chunks new nodes went into since the last call (the tail, and any it filled)."""
+        with self._lock:
+            if not self._tail_dirty:
+                return []
+            self._tail_dirty = False
+            tail = self._tail_chunk()
+            out = [(c, self._segments(c)) for c in range(self._sent_n // self.chunk, tail + 1)]
+            self._sent_n = self._n
+            return out
+
+    def take_rewired(self, limit: int) -> list[tuple[int, np.ndarray]]:
+        """Up to ``limit`` full chunks that rewires changed, oldest first."""
+        with self._lock:
+            picked = list(self._dirty)[:limit]
+            for c in picked:
+                del self._dirty[c]
+            return [(c, self._segments(c)) for c in picked]
+
+    def pending_rewired(self) -> int:
+        with self._lock:
+            return len(self._dirty)

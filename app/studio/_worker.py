@@ -1,0 +1,188 @@
+"""One session's planner on its own thread, and what it leaves for the UI to draw.
+
+The planner is stepped in short batches (~5 ms) so the UI thread gets the GIL between them;
+its listener (on this thread, where reading the tree is safe) turns kernel events into edges,
+rewire flashes, the best path and metrics in a `Live` record the UI polls.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+import time
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+
+import planner
+from app.studio._extend import StepInfo
+from app.studio._tree import EdgeChunks, edge_points
+from planner import _kernel as K
+from planner._world import path_clearances
+
+__all__ = ["Live", "PlannerWorker"]
+
+BATCH_S = 0.005
+FLASH_S = 0.6
+
+
+@dataclass
+class Live:
+    """The planner's state as the UI sees it; each part carries a version the UI compares."""
+
+    chunks: EdgeChunks = field(default_factory=EdgeChunks)
+    flashes: deque = field(default_factory=lambda: deque(maxlen=96))  # (time, old, new)
+    best_path: np.ndarray | None = None
+    best_version: int = 0
+    metrics: dict = field(default_factory=dict)
+    metrics_version: int = 0
+    cost_over_time: list = field(default_factory=list)  # (wall s, cost)
+    step: dict | None = None
+    step_version: int = 0
+    state: str = "ready"
+    error: str | None = None
+
+
+class PlannerWorker:
+    """Owns a `planner.Planner`; driven by commands (run, pause, step, stop) from the UI."""
+
+    def __init__(self, problem, settings: planner.PlannerSettings, budget: int,
+                 rate: float | None = None) -> None:
+        self.live = Live()
+        self.budget = budget
+        self.rate = rate  # iterations per second, None: as fast as it goes
+        self._problem = problem
+        self._run = planner.Planner(problem, settings)
+        self._run.add_listener(self._on_events)
+        self._star = settings.algorithm == "rrtstar"
+        self._cmds: queue.Queue[str] = queue.Queue()
+        self._stepping = False
+        self._best = None
+        self._clearance = None
+        self._wall = 0.0
+        self._last_metrics = 0.0
+        self._thread = threading.Thread(target=self._loop, daemon=True, name="planner")
+        self._on_events(None)  # the root
+        self._thread.start()
+
+    # -- commands (any thread) -----------------------------------------------------------------
+    def run(self) -> None:
+        self._cmds.put("run")
+
+    def pause(self) -> None:
+        self._cmds.put("pause")
+
+    def step(self) -> None:
+        self._cmds.put("step")
+
+    def stop(self) -> None:
+        self._cmds.put("stop")
+        self._thread.join(timeout=2.0)
+
+    @property
+    def iterations_per_s(self) -> float:
+        return self._run.iterations / self._wall if self._wall > 0 else 0.0
+
+    # -- the thread ------------------------------------------------------------------------------
+    def _loop(self) -> None:
+        running, batch = False, 16
+        while True:
+            try:
+                cmd = self._cmds.get(timeout=0.0 if running else 0.2)
+            except queue.Empty:
+                cmd = None
+            if cmd == "stop":
+                return
+            if cmd == "run":
+                running = not self._done()
+            elif cmd == "pause":
+                running = False
+            elif cmd == "step" and not self._done():
+                running = False
+                self._advance(1, stepping=True)
+            self.live.state = "done" if self._done() else ("running" if running else "paused")
+            if running:
+                n = batch if self.rate is None else max(1, int(self.rate * BATCH_S))
+                n = min(n, self.budget - self._run.iterations)
+                took = self._advance(n)
+                if self.rate is None:
+                    batch = max(1, min(20000, int(n * BATCH_S / max(took, 1e-6))))
+                else:
+                    time.sleep(max(0.0, n / self.rate - took))
+                running = not self._done()
+                time.sleep(0)  # let the UI thread take the GIL between batches
+
+    def _done(self) -> bool:
+        return self._run.finished or self._run.iterations >= self.budget
+
+    def _advance(self, n: int, stepping: bool = False) -> float:
+        t0 = time.perf_counter()
+        self._stepping = stepping
+        try:
+            self._run.step(n)
+        except Exception as exc:  # noqa: BLE001  (a planner bug must not kill the session)
+            self.live.error = f"{type(exc).__name__}: {exc}"
+            self.budget = self._run.iterations
+        took = time.perf_counter() - t0
+        self._wall += took
+        return took
+
+    # -- the listener (planner thread) ---------------------------------------------------------
+    def _on_events(self, ev: planner.TreeEvents | None) -> None:
+        tree, rho, live = self._run._tree, self._problem.rho, self.live
+        if ev is None:
+            live.chunks.set(0, edge_points(tree, 0, rho))
+            return
+        for node in ev.rows[:, K.EV_NEW].astype(int):
+            if node >= 0:
+                live.chunks.set(node, edge_points(tree, node, rho))
+        now = time.monotonic()
+        rewired = []
+        for _, node, _, _ in ev.rewires:
+            old = live.chunks.get(node)
+            new = edge_points(tree, node, rho)
+            live.chunks.set(node, new)
+            live.flashes.append((now, old, new))
+            rewired.append((old, new))
+        if self._stepping and len(ev.rows):
+            self._note_step(ev, rewired)
+        self._note_best(now)
+
+    def _note_step(self, ev: planner.TreeEvents, rewired: list) -> None:
+        row = ev.rows[-1]
+        pose = self._run._tree.pose
+        info = StepInfo.from_row(row, len(rewired))
+        near = ev.near[int(max(row[K.EV_NEAR_START], 0)):int(max(row[K.EV_NEAR_END], 0))]
+        self.live.step = {
+            "info": info, "star": self._star,
+            "x_rand": row[[K.EV_XR, K.EV_YR, K.EV_THR]].copy(),
+            "nearest": pose[info.nearest].copy() if info.nearest >= 0 else None,
+            "new": pose[info.new].copy() if info.new >= 0 else None,
+            "parent_edge": (self.live.chunks.get(info.new) if info.new >= 0 else None),
+            "near": pose[near].copy(), "radius": info.radius, "rewired": rewired,
+        }
+        self.live.step_version += 1
+
+    def _note_best(self, now: float) -> None:
+        run, live = self._run, self.live
+        cost = run.best_cost
+        if cost is not None and (self._best is None or cost < self._best - 1e-9):
+            self._best = cost
+            live.best_path = run.dense_path(0.05)
+            self._clearance = float(path_clearances(self._problem.world, live.best_path,
+                                                    self._problem.timed).min())
+            live.best_version += 1
+            live.cost_over_time.append((self._wall, cost))
+        if now - self._last_metrics >= 0.5 or self._stepping:
+            self._last_metrics = now
+            live.metrics = self._metrics()
+            live.metrics_version += 1
+
+    def _metrics(self) -> dict:
+        run = self._run
+        return {"iterations": run.iterations, "nodes": run.nodes,
+                "rewires": int(run._tree.cnt[K.REWIRES]),
+                "time_to_first_solution_s": run._clock.first_solution_s,
+                "cost": run.best_cost, "min_clearance_m": self._clearance,
+                "iterations_per_s": self.iterations_per_s}
