@@ -1,0 +1,25 @@
+"""Run metrics from the per-tick record: collisions, clearance, timing shares, percentiles."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["collision_runs", "cycle_stats"]
+
+
+def collision_runs(clearances: np.ndarray) -> int:
+    """Contacts: maximal runs of consecutive ticks in collision (clearance ≤ 0, touching counts)."""
+    hit = np.asarray(clearances) <= 0.0
+    return int(np.count_nonzero(hit[1:] & ~hit[:-1]) + (1 if len(hit) and hit[0] else 0))
+
+
+def cycle_stats(wall_s: list[float]) -> dict:
+    """Cycle-time percentiles (ms) and the shares of cycles within 1/30 s and 1/4 s."""
+    if not wall_s:
+        return {"cycle_ms": {"p50": None, "p95": None, "p99": None, "max": None},
+                "share_30hz": None, "share_4hz": None}
+    ms = np.asarray(wall_s) * 1000.0
+    p = {f"p{q}": float(np.percentile(ms, q)) for q in (50, 95, 99)}
+    p["max"] = float(ms.max())
+    return {"cycle_ms": p, "share_30hz": float(np.mean(ms <= 1000.0 / 30.0)),
+            "share_4hz": float(np.mean(ms <= 250.0))}

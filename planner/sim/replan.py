@@ -1,0 +1,199 @@
+"""One replanning cycle: commit, predict, re-root the tree, grow it, hand back a trajectory.
+
+The replanner keeps the RRT* tree between cycles. Each cycle commits to the stretch of the
+current trajectory the car will drive before the new plan can arrive, re-roots the tree at the
+end of that stretch (keeping the still-valid subtree ahead, see `_reroot`), grows it for one
+cycle's budget in the world the car believes in (sensed movers at constant velocity), and
+returns the committed stretch followed by the tree's best path. It also reports how far the car
+may drive on the trajectory before a predicted conflict, for the speed governor.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from planner import _kernel as K
+from planner._paths import pose_at
+from planner._world import clearance, path_clearances
+from planner.problem import Problem
+from planner.rrt import Planner, PlannerSettings
+from planner.sim._reroot import reroot
+from planner.sim.control import Reference
+from planner.sim.predict import inflated, predicted_world
+from planner.sim.sensing import Sensing
+
+__all__ = ["Cycle", "Replanner"]
+
+SPACING = 0.05  # m between reference rows
+KEEP_BEHIND = 1.0  # m of driven reference kept (for the projection window)
+# Plans end in the inner part of the goal region, so that the tracked pose, a few cm and
+# degrees off the plan, still ends inside it.
+GOAL_SHARE = 0.6
+# Re-rooting keeps nodes that could lie on a path at most this much longer than the current
+# plan (informed pruning with slack: alternatives for when the plan becomes blocked).
+PRUNE_FACTOR, PRUNE_SLACK = 1.5, 2.0
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """What a cycle delivers. ``reference`` None: keep the committed one."""
+
+    reference: Reference | None
+    replaced: bool
+    stop_s: float  # arc on the delivered (or kept) reference where the car must be at rest
+    conflict: bool  # stop_s comes from a predicted conflict, not the end of the trajectory
+    wall_s: float
+    nodes: int
+
+
+class Replanner:
+    """The planning side of the car: its tree, its committed trajectory, its budget."""
+
+    def __init__(self, problem: Problem, settings: PlannerSettings, *, seed: int,
+                 budget_s: float | None, iterations: int | None, margin: float,
+                 horizon_s: float = 4.0) -> None:
+        self.problem = problem
+        self.settings = settings.resolved(problem)
+        self.seed = seed
+        self.budget_s = budget_s
+        self.iterations = iterations
+        self.margin = margin
+        self.horizon_s = horizon_s
+        self.planner: Planner | None = None
+        self.attached = False  # the reference from root_s on is the planner's best path
+        self.root_s = 0.0  # arc of the planner's root on the reference
+        self.reference: Reference | None = None
+        self.count = 0
+
+    # -- the cycle ---------------------------------------------------------------------------
+    def cycle(self, t: float, sensing: Sensing, pose, v: float, s_now: float,
+              lead_s: float) -> Cycle:
+        """Plan from the state the car will be in ``lead_s`` seconds after t."""
+        started = time.perf_counter()
+        self.count += 1
+        a = self.problem.scenario.vehicle.max_accel
+        commit = max(v, 0.0) * lead_s + 0.5 * a * lead_s ** 2 if v > 1e-9 else 0.0
+        root, anchor, skip, s_c = self._commit_point(pose, s_now, commit)
+        believed = predicted_world(self.problem.world, sensing, t + lead_s)
+        plan_world = inflated(believed, self.margin)
+        if clearance(plan_world, root[0], root[1], 0.0) <= 0.0:
+            plan_world = believed  # already inside the margin: plan with the bare disc
+        self._s_c = s_c
+        old, old_cost = self.planner, self._remaining_cost(s_c)
+        planner = self._new_planner(plan_world, root, old, anchor, skip)
+        self._grow(planner, started)
+        replaced = False
+        self.shift = 0.0
+        if planner.solved:
+            replaced = not (self.attached and abs(planner.best_cost - old_cost) < 1e-9)
+            path = planner.dense_path(SPACING)[:, :5]
+            self.reference = self._joined(s_c, path, s_now)
+            self.attached, self.planner = True, planner
+        else:
+            self.attached, self.planner = False, planner
+            self.root_s = s_c
+        stop_s, conflict = self._stop_point(believed, t, lead_s, s_now)
+        return Cycle(self.reference if planner.solved else None, replaced, stop_s, conflict,
+                     time.perf_counter() - started, planner.nodes)
+
+    def _commit_point(self, pose, s_now: float, commit: float):
+        """(root pose, anchor node, skip, arc) of the state ``commit`` metres ahead."""
+        ref = self.reference
+        if ref is None:
+            return tuple(pose), 0, 0.0, 0.0
+        s_c = min(s_now + commit, ref.length)
+        if self.attached and self.planner is not None:
+            chain = self.planner.best_path_nodes()
+            tree = self.planner._tree
+            s_c = max(s_c, self.root_s)  # never behind the tree's root (the last commit)
+            rel = s_c - self.root_s
+            costs = tree.cost[chain]
+            i = int(np.searchsorted(costs, rel, side="right"))
+            if i >= len(chain):
+                return tuple(tree.pose[chain[-1]]), chain[-1], 0.0, s_c
+            node, par = chain[i], chain[i - 1]
+            skip = rel - costs[i - 1]
+            if skip <= 1e-12:
+                return tuple(tree.pose[par]), par, 0.0, s_c
+            x, y, th, _, _ = pose_at(*tree.pose[par], tree.kinds[node], tree.lens[node],
+                                     self.problem.rho, skip)
+            return (x, y, th), node, skip, s_c
+        return tuple(ref.point_at(s_c)[:3]), -1, 0.0, s_c
+
+    def _remaining_cost(self, s_c: float) -> float:
+        if not (self.attached and self.planner is not None and self.planner.solved):
+            return math.inf
+        return self.planner.best_cost - (s_c - self.root_s)
+
+    def _new_planner(self, world, root, old: Planner | None, anchor: int, skip: float):
+        """A tree rooted at ``root`` holding what is still valid of the old one."""
+        same_root = (old is not None and not self.attached
+                     and np.allclose(old._tree.pose[0], root, rtol=0.0, atol=1e-12))
+        keep = old is not None and ((self.attached and anchor >= 0) or same_root)
+        capacity = max(4096, 2 * old.nodes) if keep else 4096
+        problem = dataclasses.replace(
+            self.problem, world=world, start=tuple(root), timed=True,
+            goal_position_tol=GOAL_SHARE * self.problem.goal_position_tol,
+            goal_heading_tol=GOAL_SHARE * self.problem.goal_heading_tol)
+        settings = dataclasses.replace(self.settings, seed=self.seed * 1_000_003 + self.count)
+        planner = Planner(problem, settings, capacity=capacity)
+        if keep:
+            remaining = self._remaining_cost(self._s_c)
+            bound = PRUNE_FACTOR * remaining + PRUNE_SLACK if math.isfinite(remaining) else math.inf
+            reroot(old._tree, planner._tree, world, planner._P, 0 if same_root else anchor,
+                   0.0 if same_root else skip, bound)
+            K._update_best(planner._tree)
+        return planner
+
+    def _grow(self, planner: Planner, started: float) -> None:
+        if self.iterations is not None:
+            planner.step(self.iterations)
+            return
+        batch = 8
+        while time.perf_counter() - started < self.budget_s:
+            t0 = time.perf_counter()
+            planner.step(batch)
+            took = time.perf_counter() - t0
+            batch = max(1, min(512, int(batch * (0.001 / took if took > 0 else 2.0))))
+
+    def _joined(self, s_c: float, path: np.ndarray, s_now: float) -> Reference:
+        """The committed stretch (from a little behind the car) followed by the new plan."""
+        ref = self.reference
+        if ref is None:
+            self.root_s = 0.0
+            return Reference(path)
+        lo = int(np.searchsorted(ref.s, s_now - KEEP_BEHIND))
+        hi = int(np.searchsorted(ref.s, s_c - 1e-9))
+        rows = np.vstack([ref.rows[lo:hi], path]) if hi > lo else path
+        out = Reference(rows)
+        self.shift = float(ref.s[lo]) if hi > lo else s_c
+        self.root_s = float(out.s[hi - lo]) if hi > lo else 0.0
+        out.cursor = max(int(np.searchsorted(out.s, s_now - self.shift)) - 1, 0)
+        return out
+
+    def _stop_point(self, believed, t: float, lead_s: float, s_now: float):
+        """Arc where the car must stop: before the first predicted conflict within the horizon
+        on the reference it will follow, else at the reference's end."""
+        ref = self.reference
+        if ref is None:
+            return 0.0, False
+        s_now = max(s_now - self.shift, 0.0)  # in the arcs of the reference just built
+        speed = self.settings.speed
+        i0 = int(np.searchsorted(ref.s, s_now))
+        i1 = int(np.searchsorted(ref.s, s_now + speed * self.horizon_s))
+        rows = ref.rows[i0:i1 + 1]
+        if len(rows) == 0:
+            return ref.length, False
+        samples = np.zeros((len(rows), 6))
+        samples[:, :5] = rows
+        samples[:, 5] = (ref.s[i0:i0 + len(rows)] - s_now) / speed - lead_s
+        c = path_clearances(believed, samples, True)
+        hit = np.flatnonzero(c <= 0.02)
+        if len(hit):
+            return float(ref.s[i0 + hit[0]]) - 0.15, True
+        return ref.length, False

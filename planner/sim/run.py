@@ -1,0 +1,196 @@
+"""The simulation loop: world, sensors, replanner and car on one simulated clock.
+
+Control ticks at ``control_rate`` drive the clock. A replanning cycle that starts at tick time t
+hands its plan over at t + max(1/rate, its measured wall time) — or the fixed latency — and the
+next cycle starts then; until then the car follows the committed trajectory. The simulation is
+not paced to the wall clock unless ``realtime``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from planner._world import path_clearances
+from planner.problem import Problem, compile_problem
+from planner.rrt import PlannerSettings, warm_up
+from planner.scenario import Scenario
+from planner.sim.control import CONTROLLERS, Tracking, steer_command
+from planner.sim.metrics import collision_runs, cycle_stats
+from planner.sim.replan import Replanner
+from planner.sim.sensing import mover_index, sense, true_offsets
+from planner.sim.vehicle import Limits, arc_step, limit_commands
+
+__all__ = ["SimRun", "SimSettings", "simulate"]
+
+
+@dataclass(frozen=True)
+class SimSettings:
+    """Every setting of a run (reported back as ``parameters``)."""
+
+    duration: float = 60.0
+    rate: float = 30.0  # replanning cycles per second
+    control_rate: float = 100.0
+    sense_rate: float = 10.0
+    controller: str = "pure-pursuit"
+    noise: float = 0.0  # σ (m) of sensed positions
+    seed: int = 0
+    fixed_latency_ms: float | None = None  # a fixed cycle time instead of the measured one
+    replan: bool = True  # False: one plan at t = 0, followed blind
+    budget_share: float = 0.3  # planner time per cycle, as a share of 1/rate
+    iterations: int = 80  # planner iterations per cycle under a fixed latency
+    margin: float = 0.05  # m added to the car's radius when planning
+    realtime: bool = False
+
+    def __post_init__(self) -> None:
+        for name in ("duration", "rate", "control_rate", "sense_rate"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"--{name.replace('_', '-')} must be a finite number > 0, "
+                                 f"got {v}")
+        if self.controller not in CONTROLLERS:
+            raise ValueError(f"unknown controller '{self.controller}' "
+                             f"(use one of {', '.join(CONTROLLERS)})")
+        if not (math.isfinite(self.noise) and self.noise >= 0):
+            raise ValueError(f"--noise must be a finite number >= 0, got {self.noise}")
+        if self.fixed_latency_ms is not None and not (
+                math.isfinite(self.fixed_latency_ms) and self.fixed_latency_ms >= 0):
+            raise ValueError(f"--fixed-latency must be a finite number >= 0, "
+                             f"got {self.fixed_latency_ms}")
+
+
+@dataclass
+class SimRun:
+    """The outcome: the JSON summary and the per-tick log (columns in ``columns``)."""
+
+    summary: dict
+    columns: list[str]
+    log: np.ndarray
+    cycles: list[dict] = field(default_factory=list)
+
+    def write_log(self, path) -> None:
+        np.savetxt(path, self.log, delimiter=",", header=",".join(self.columns), comments="",
+                   fmt="%.12g")
+
+
+def _in_goal(problem: Problem, x: float, y: float, th: float) -> bool:
+    gx, gy, gth = problem.goal
+    return (math.hypot(x - gx, y - gy) <= problem.goal_position_tol
+            and abs(math.remainder(th - gth, 2.0 * math.pi)) <= problem.goal_heading_tol)
+
+
+def simulate(scenario: Scenario, settings: SimSettings | None = None,
+             problem: Problem | None = None) -> SimRun:
+    """Drive the scenario's car to its goal; raises ScenarioError / ValueError on bad input."""
+    s = settings or SimSettings()
+    problem = problem or compile_problem(scenario)
+    warm_up()
+    vehicle = scenario.vehicle
+    limits = Limits.of(vehicle)
+    dt = 1.0 / s.control_rate
+    n_ticks = round(s.duration * s.control_rate)
+    movers = mover_index(scenario)
+    rng = np.random.default_rng(s.seed)
+    fixed = s.fixed_latency_ms / 1000.0 if s.fixed_latency_ms is not None else None
+    replanner = Replanner(problem, PlannerSettings(seed=s.seed), seed=s.seed,
+                          budget_s=s.budget_share / s.rate,
+                          iterations=s.iterations if fixed is not None else None,
+                          margin=s.margin)
+    gains = Tracking()
+    cruise = vehicle.speed
+    x, y, th = problem.start
+    est = (x, y, th)
+    v = steer = 0.0
+    e_old = math.nan
+    sensing, j_sense = None, 0
+    ref, stop_s, conflict = None, 0.0, False
+    pending, next_cycle = None, 0.0
+    walls, cycles, replans, stops, was_stopped = [], [], 0, 0, False
+    rows, lat = [], []
+    wall0 = time.perf_counter()
+    reached = False
+    for k in range(n_ticks + 1):
+        t = k * dt
+        while j_sense / s.sense_rate <= t + 1e-9:  # sensing instants up to now
+            ts = j_sense / s.sense_rate
+            sensing = sense(problem.world, movers, ts, s.sense_rate, s.noise, rng)
+            noise = rng.normal(0.0, s.noise, 2) if s.noise > 0 else (0.0, 0.0)
+            est = (x + noise[0], y + noise[1], th)
+            j_sense += 1
+        if pending is not None and pending[0] <= t + 1e-9:
+            cyc = pending[1]
+            if cyc.reference is not None:
+                ref = cyc.reference
+            stop_s, conflict = cyc.stop_s, cyc.conflict and s.replan
+            replans += cyc.replaced
+            pending = None
+        if pending is None and t >= next_cycle - 1e-9 and (s.replan or ref is None):
+            s_now = ref.s[ref.project(est[0], est[1])[0]] if ref is not None else 0.0
+            lead = max(1.0 / s.rate, fixed if fixed is not None else
+                       (walls[-1] if walls else 0.0))
+            cyc = replanner.cycle(t, sensing, est, v, s_now, lead)
+            latency = fixed if fixed is not None else cyc.wall_s
+            walls.append(latency)
+            cycles.append({"t": t, "ms": cyc.wall_s * 1000.0, "replaced": cyc.replaced,
+                           "nodes": cyc.nodes})
+            pending = (t + max(1.0 / s.rate, latency), cyc)
+            next_cycle = pending[0]
+        # Control: track the committed trajectory at cruise speed, governed to stop in time.
+        want_v, want_steer, e = 0.0, steer, math.nan
+        if ref is not None:
+            i, e = ref.project(est[0], est[1])
+            room = stop_s - ref.s[i] if (s.replan or not conflict) else math.inf
+            if not s.replan:
+                room = ref.length - ref.s[i]
+            want_v = min(cruise, math.sqrt(2.0 * limits.max_accel * max(room, 0.0)))
+            want_steer = steer_command(s.controller, ref, i, e, e_old, est, v,
+                                       limits.wheelbase, dt, gains)
+        v_cmd, steer_cmd = limit_commands(v, steer, want_v, want_steer, limits, dt)
+        e_old = e
+        stopped = ref is not None and conflict and abs(v_cmd) < 1e-9
+        stops += stopped and not was_stopped
+        was_stopped = stopped
+        rows.append((t, x, y, th, v_cmd, steer_cmd, want_steer, e,
+                     replanner.planner.nodes if replanner.planner else 0))
+        lat.append(abs(e))
+        v, steer = v_cmd, steer_cmd
+        if _in_goal(problem, x, y, th):
+            reached = True
+            break
+        if k == n_ticks:
+            break
+        x, y, th = arc_step(x, y, th, v, steer, limits.wheelbase, dt)
+        est = arc_step(*est, v, steer, limits.wheelbase, dt)  # dead reckoning on the commands
+        if s.realtime:
+            time.sleep(max(0.0, t + dt - (time.perf_counter() - wall0)))
+    log = np.array(rows, dtype=float)
+    offsets = true_offsets(problem.world, movers, log[:, 0])
+    samples = np.zeros((len(log), 6))
+    samples[:, :3] = log[:, 1:4]
+    samples[:, 5] = log[:, 0]
+    clear = path_clearances(problem.world, samples, True)
+    lat = np.asarray(lat)
+    lat = lat[np.isfinite(lat)]
+    columns = ["t", "x", "y", "theta", "v", "steer"]
+    columns += [f"obs{i}_{a}" for i in range(len(movers)) for a in ("dx", "dy")]
+    columns += ["steer_set", "lateral_error", "tree_nodes", "clearance"]
+    table = np.column_stack([log[:, :6], offsets.reshape(len(log), -1), log[:, 6:], clear])
+    summary = {
+        "reached_goal": reached,
+        "time_to_goal_s": float(log[-1, 0]) if reached else None,
+        "duration_s": float(log[-1, 0]),
+        "collisions": collision_runs(clear),
+        "min_clearance_m": float(clear.min()),
+        "cycles": len(walls),
+        "replans": int(replans),
+        **cycle_stats(walls),
+        "emergency_stops": int(stops),
+        "cross_track_error_m": {"mean": float(lat.mean()) if len(lat) else None,
+                                "max": float(lat.max()) if len(lat) else None},
+        "distance_m": float(np.abs(log[:, 4]).sum() * dt) - float(abs(log[-1, 4]) * dt),
+        "parameters": asdict(s),
+    }
+    return SimRun(summary, columns, table, cycles)
