@@ -27,7 +27,7 @@ from planner.sim.control import Reference
 from planner.sim.predict import inflated, predicted_world
 from planner.sim.sensing import Sensing
 
-__all__ = ["Cycle", "Replanner"]
+__all__ = ["Cycle", "Replanner", "warm_up"]
 
 SPACING = 0.05  # m between reference rows
 KEEP_BEHIND = 1.0  # m of driven reference kept (for the projection window)
@@ -197,3 +197,23 @@ class Replanner:
         if len(hit):
             return float(ref.s[i0 + hit[0]]) - 0.15, True
         return ref.length, False
+
+
+_warm = False
+
+
+def warm_up() -> None:
+    """Load (or compile) the re-rooting kernel once, so that no cycle time includes it."""
+    global _warm
+    if _warm:
+        return
+    from planner._world import build_world
+
+    world = build_world((0, 0, 10, 10), 0.1, [(5, 5, 1, 0)], [], [("velocity", (0.1, 0))])
+    problem = Problem(None, world, (0.5, 0.5, 0.0), (9, 9, 0.0), 0.5, 0.5, 1.0, 1.0, True)
+    old = Planner(problem, PlannerSettings())
+    old.step(40)
+    new = Planner(problem, PlannerSettings())
+    reroot(old._tree, new._tree, world, new._P, 0, 0.0, math.inf)
+    pose_at(0.0, 0.0, 0.0, old._tree.kinds[1], old._tree.lens[1], 1.0, 0.1)
+    _warm = True

@@ -21,6 +21,7 @@ from planner.scenario import Scenario
 from planner.sim.control import CONTROLLERS, Tracking, steer_command
 from planner.sim.metrics import collision_runs, cycle_stats
 from planner.sim.replan import Replanner
+from planner.sim.replan import warm_up as warm_up_replanning
 from planner.sim.sensing import mover_index, sense, true_offsets
 from planner.sim.vehicle import Limits, arc_step, limit_commands
 
@@ -88,6 +89,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     s = settings or SimSettings()
     problem = problem or compile_problem(scenario)
     warm_up()
+    warm_up_replanning()
     vehicle = scenario.vehicle
     limits = Limits.of(vehicle)
     dt = 1.0 / s.control_rate
