@@ -83,15 +83,15 @@ def test_bad_jobs_are_refused(server, body, status, words):
 
 def test_server_answers_while_the_pool_is_busy(server):
     body = {"scenarios": [scenario_dict("slalom")], "parameters": [{"time": 1.0}],
-            "seeds": list(range(8))}
+            "seeds": list(range(40))}  # ~20 s of work: still running when checked
     job_id = server.client.post("/jobs", json=body).json()["id"]
     time.sleep(0.3)
-    slowest = 0.0
-    for _ in range(20):
+    latencies = []
+    for _ in range(21):
         start = time.monotonic()
         assert server.get("/health").status_code == 200
-        slowest = max(slowest, time.monotonic() - start)
+        latencies.append(time.monotonic() - start)
         time.sleep(0.05)
     assert server.client.get(f"/jobs/{job_id}").json()["status"] == "running"
-    assert slowest < 0.5
+    assert sorted(latencies)[10] < 0.1, latencies  # the median: robust to a loaded runner
     server.client.delete(f"/jobs/{job_id}")
