@@ -81,15 +81,15 @@ async def run(url: str, clients: int, plan_s: float, duration: float) -> str:
                                for _ in range(clients)))
         elapsed = time.monotonic() - start
     return "\n".join([
-        f"# Server load: {clients} clients × {plan_s} s plans for {duration:.0f} s "
-        f"({os.cpu_count()} CPUs)",
+        (f"# Server load: {clients} clients × {plan_s} s plans for {duration:.0f} s "
+         f"({os.cpu_count()} CPUs)"),
         "",
         "| requests | count | p50 (ms) | p95 (ms) | p99 (ms) | throughput (/s) |",
         "|---|---|---|---|---|---|",
-        f"| POST /plan | {len(plans)} | {ms(plans, 50)} | {ms(plans, 95)} | {ms(plans, 99)} | "
-        f"{len(plans) / elapsed:.2f} |",
-        f"| GET /health | {len(health)} | {ms(health, 50)} | {ms(health, 95)} | "
-        f"{ms(health, 99)} | – |",
+        (f"| POST /plan | {len(plans)} | {ms(plans, 50)} | {ms(plans, 95)} | {ms(plans, 99)} | "
+         f"{len(plans) / elapsed:.2f} |"),
+        (f"| GET /health | {len(health)} | {ms(health, 50)} | {ms(health, 95)} | "
+         f"{ms(health, 99)} | – |"),
         "",
         f"errors: {len(errors)}" + "".join(f"\n- {e}" for e in errors[:10]),
         "",

@@ -46,9 +46,10 @@ class Server:
         self.port, self.ui_port = int(api[2]), int(ui[2])
         self.url = f"http://127.0.0.1:{self.port}"
         self.client = httpx.Client(base_url=self.url + "/api/v1", timeout=60)
+        self.root = httpx.Client(base_url=self.url, timeout=60)
 
     def get(self, path: str, **kw) -> httpx.Response:
-        return httpx.get(self.url + path, timeout=60, **kw)
+        return self.root.get(path, **kw)
 
     def stop(self, sig: int = signal.SIGTERM) -> float:
         """Signal the server and wait for it; returns the seconds it took to exit."""

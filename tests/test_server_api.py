@@ -21,7 +21,7 @@ TWO_PATHS = (f'<svg {SVG_NS} width="100mm" height="50mm" viewBox="0 0 100 50">'
 
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
-    srv = Server(tmp_path_factory.mktemp("data"), "--max-upload-mb", "0.05",
+    srv = Server(tmp_path_factory.mktemp("data"), "--max-upload-mb", "0.1",
                  "--max-plan-s", "3")
     yield srv
     srv.stop()
@@ -112,8 +112,8 @@ def test_delete_upload_but_not_library(server):
     ((b'<?xml version="1.0"?><!DOCTYPE svg [<!ENTITY x SYSTEM "file:///etc/passwd">]>'
      b'<svg xmlns="http://www.w3.org/2000/svg"><text>&x;</text></svg>'), 400, "unsafe XML"),
     (f'<svg {SVG_NS}><text>no paths</text></svg>'.encode(), 400, "no path"),
-    (f'<svg {SVG_NS}><path d="M0 0 {"l1 1 " * 10_001}"/></svg>'.encode(), 400, "segments"),
-    (b"<svg " + b"x" * 60_000 + b"/>", 413, "limit"),
+    (f'<svg {SVG_NS}><path d="M0 0 l{" 1 1" * 20_001}"/></svg>'.encode(), 400, "segments"),
+    (b"<svg " + b"x" * 120_000 + b"/>", 413, "limit"),
 ])
 def test_bad_uploads_are_refused_with_a_message(server, data, status, words):
     resp = upload(server, data)
@@ -136,6 +136,15 @@ def test_unknown_ids_are_404(server):
         resp = server.client.get(path)
         assert resp.status_code == 404 and "nope" in resp.json()["detail"], path
     assert server.client.post("/plan", json={"scenario_id": "nope"}).status_code == 404
+
+
+def test_the_openapi_example_plans_and_the_schema_is_served(server):
+    spec = server.get("/openapi.json").json()
+    example = spec["components"]["schemas"]["PlanRequest"]["examples"][0]
+    report = server.client.post("/plan", json=example)
+    assert report.status_code == 200 and report.json()["solved"], report.text
+    schema = server.client.get("/scenarios/schema").json()
+    assert {"start", "goal", "obstacles", "track"} <= schema["properties"].keys()
 
 
 def test_scenarios_crud(server):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import re
 import signal
 import socket
@@ -109,5 +110,23 @@ def test_the_dockerfile_cmd_serves_health(tmp_path):
         assert any("no authentication" in line for line in srv.err)
         health = srv.get("/health").json()
         assert health["status"] == "ok" and health["ui_port"] == ui_port
+    finally:
+        assert srv.stop() < 5
+
+
+def test_a_dead_worker_is_replaced(tmp_path):
+    srv = Server(tmp_path)
+    try:
+        children = Path(f"/proc/{srv.proc.pid}/task/{srv.proc.pid}/children").read_text().split()
+        workers = [pid for pid in children
+                   if b"spawn_main" in Path(f"/proc/{pid}/cmdline").read_bytes()]
+        assert workers
+        os.kill(int(workers[0]), signal.SIGKILL)
+        body = {"scenario": scenario_dict("slalom"), "iterations": 100}
+        statuses = [srv.client.post("/plan", json=body) for _ in range(3)]
+        assert {r.status_code for r in statuses} <= {200, 503}
+        assert statuses[-1].status_code == 200
+        failed = [r for r in statuses if r.status_code == 503]
+        assert all("try again" in r.json()["detail"] for r in failed)
     finally:
         assert srv.stop() < 5

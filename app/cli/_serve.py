@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import asyncio
 import ipaddress
+import os
 import signal
 import socket
 import sys
@@ -29,8 +30,8 @@ def _listen(host: str, port: int, what: str) -> socket.socket:
     try:
         return socket.create_server((host, port), family=family)
     except OSError as exc:
-        raise InputError(f"{what} port {port} on {host} is not available: "
-                         f"{exc.strerror or exc}") from None
+        reason = os.strerror(exc.errno) if exc.errno else str(exc)
+        raise InputError(f"{what} port {port} on {host} is not available: {reason}") from None
 
 
 def _is_loopback(host: str) -> bool:
@@ -48,7 +49,8 @@ async def _run(app, api: socket.socket, host: str, ui: socket.socket) -> None:
 
     api_port, ui_port = api.getsockname()[1], ui.getsockname()[1]
     ui.close()  # viser binds it itself; checked free just now
-    studio = await asyncio.to_thread(launch, host, ui_port, f"http://{host}:{api_port}/api/v1")
+    local = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host)  # the studio calls from here
+    studio = await asyncio.to_thread(launch, host, ui_port, f"http://{local}:{api_port}/api/v1")
     try:
         if studio.port != ui_port:
             raise InputError(f"studio port {ui_port} on {host} became busy")

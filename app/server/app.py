@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import asynccontextmanager
 from dataclasses import dataclass
 from importlib.metadata import version
@@ -107,6 +108,11 @@ def create_app(settings: ServerSettings) -> FastAPI:
     @app.exception_handler(ScenarioError)
     async def unplannable(request: Request, exc: ScenarioError) -> JSONResponse:
         return JSONResponse({"detail": str(exc)}, status_code=422)
+
+    @app.exception_handler(BrokenProcessPool)
+    async def worker_died(request: Request, exc: BrokenProcessPool) -> JSONResponse:
+        return JSONResponse({"detail": "a planning worker stopped (out of memory?); the pool "
+                                       "has been restarted, try again"}, status_code=503)
 
     @app.get("/health", response_model=Health, tags=["server"])
     def health() -> Health:

@@ -15,6 +15,7 @@ import multiprocessing
 import os
 import signal
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 
 from app.planning import PlanOptions, TrackSource, check_scenario, run_plan
 from app.server.store import Store
@@ -50,17 +51,28 @@ class Planning:
         self.store = store
         self.max_plan_s = max_plan_s
         self.workers = workers or machine_workers()
-        # spawn, not fork: the server process runs threads (uvicorn, viser, sqlite).
-        self.pool = ProcessPoolExecutor(self.workers, multiprocessing.get_context("spawn"),
-                                        initializer=_worker_start)
+        self.pool = self._start_pool()
         self._jobs: dict[str, asyncio.Task] = {}
         store.fail_unfinished(CRASHED)
+
+    def _start_pool(self) -> ProcessPoolExecutor:
+        # spawn, not fork: the server process runs threads (uvicorn, viser, sqlite).
+        pool = ProcessPoolExecutor(self.workers, multiprocessing.get_context("spawn"),
+                                   initializer=_worker_start)
         for _ in range(self.workers):  # start every worker now, not at the first request
-            self.pool.submit(int)
+            pool.submit(int)
+        return pool
 
     async def _call(self, fn, *args, **kwargs):
         loop = asyncio.get_running_loop()
-        return await loop.run_in_executor(self.pool, functools.partial(fn, *args, **kwargs))
+        pool = self.pool
+        try:
+            return await loop.run_in_executor(pool, functools.partial(fn, *args, **kwargs))
+        except BrokenProcessPool:  # a worker died (killed, out of memory): replace the pool
+            if self.pool is pool:
+                self.pool = self._start_pool()
+                pool.shutdown(wait=False, cancel_futures=True)
+            raise
 
     async def check(self, scenario: dict, track: TrackSource | None) -> None:
         """Raise ScenarioError unless the scenario compiles (done in a worker: it may be slow)."""

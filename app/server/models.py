@@ -15,6 +15,15 @@ from planner.report import PlanReport
 
 Point = tuple[float, float]
 
+SCENARIO_EXAMPLE = {
+    "name": "two-cones", "bounds": [0, 0, 10, 6],
+    "vehicle": {"wheelbase": 0.44, "max_steer_deg": 26, "radius": 0.2},
+    "start": [1, 3, 0], "goal": [9, 3, 0],
+    "obstacles": [{"type": "circle", "center": [4, 3], "radius": 0.8},
+                  {"type": "box", "center": [7, 2], "size": [1.0, 0.6], "angle_deg": 30,
+                   "motion": {"velocity": [0, 0.3]}}],
+}
+
 
 class _Body(BaseModel):
     model_config = ConfigDict(extra="forbid")
@@ -92,7 +101,11 @@ class ScenarioRecord(BaseModel):
 class PlanRequest(PlanOptions):
     """One plan: a scenario inline or by id, and the options of `trackstar plan`."""
 
-    scenario: dict[str, Any] | None = None
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"scenario": SCENARIO_EXAMPLE, "time": 0.5}]})
+
+    scenario: dict[str, Any] | None = Field(
+        None, description="FORMAT.md or the rich schema (GET /scenarios/schema)")
     scenario_id: str | None = None
 
     @model_validator(mode="after")

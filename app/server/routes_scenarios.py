@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Annotated, Any
 
-from fastapi import APIRouter, HTTPException, Request, Response
+from fastapi import APIRouter, Body, HTTPException, Request, Response
 
 import planner
 import tracks
 from app.planning import TrackSource
-from app.server.models import ScenarioRecord
+from app.server.models import SCENARIO_EXAMPLE, ScenarioRecord
 
 router = APIRouter(tags=["scenarios"])
 
@@ -38,8 +38,17 @@ def resolve(request: Request, body: dict[str, Any] | str) -> tuple[dict, TrackSo
     return body, TrackSource(id=row["id"], svg=row["svg"], path=row["path"], unit=row["unit"])
 
 
+@router.get("/scenarios/schema")
+def schema() -> dict:
+    """The JSON Schema of the rich scenario format (FORMAT.md scenarios are valid too)."""
+    return planner.scenario_schema()
+
+
 @router.post("/scenarios", response_model=ScenarioRecord, status_code=201)
-async def create_scenario(request: Request, scenario: dict[str, Any]) -> ScenarioRecord:
+async def create_scenario(
+    request: Request,
+    scenario: Annotated[dict[str, Any], Body(examples=[SCENARIO_EXAMPLE])],
+) -> ScenarioRecord:
     """Store a scenario (FORMAT.md or the rich schema) once it is known to be plannable: valid
     fields, start and goal free. Its track may be a library name or an uploaded track's id."""
     body, track = resolve(request, scenario)
