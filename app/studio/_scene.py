@@ -150,6 +150,10 @@ def fit_camera(client, bounds, fov_deg: float = 20.0, usable: float = 0.72) -> N
     with client.atomic():
         client.camera.fov = math.radians(fov_deg)
         client.camera.up_direction = (0.0, 0.0, 1.0)
+        # Small tracks (an SVG in millimetres) need the camera closer than viser's default
+        # closest orbit distance.
+        client.camera.min_orbit_distance = min(0.05 * h, client.camera.max_orbit_distance)
+        client.camera.near = 0.01 * h
         client.camera.position = (cx, cy - 0.01 * h, h)
         client.camera.look_at = (cx, cy, 0.0)
         client.camera.far = 10 * h

@@ -1,0 +1,215 @@
+"""The studio in a real browser: Debian's chromium (Playwright) against `trackstar serve`.
+
+One server process and one browser for the module; every test opens its own tab, which is its
+own studio session. Screenshots land in tests/artifacts/studio/ for a human to look at.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+playwright = pytest.importorskip("playwright.sync_api")
+
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+ARTIFACTS = Path(__file__).parent / "artifacts" / "studio"
+ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync", "--enable-unsafe-swiftshader",
+        "--use-gl=swiftshader"]
+
+pytestmark = pytest.mark.skipif(not os.path.exists(CHROMIUM) and not os.environ.get("CI"),
+                                reason="Debian's chromium is not installed")
+
+
+@pytest.fixture(scope="module")
+def ui_url(tmp_path_factory):
+    exe = shutil.which("trackstar")
+    cmd = ([exe] if exe else [sys.executable, "-m", "app.cli"]) + [
+        "serve", "--port", "0", "--ui-port", "0", "--data-dir",
+        str(tmp_path_factory.mktemp("data"))]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    url, seen = None, []
+    deadline = time.monotonic() + 120
+    while url is None and time.monotonic() < deadline:
+        line = proc.stdout.readline()
+        if not line:
+            break
+        seen.append(line)
+        m = re.match(r"UI: (http://\S+)", line)
+        url = m.group(1) if m else None
+    assert url, "trackstar serve printed no UI line:\n" + "".join(seen[-20:])
+    yield url
+    proc.terminate()
+    proc.wait(timeout=10)
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with playwright.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=ARGS)
+        yield b
+        b.close()
+
+
+def open_tab(browser, url):
+    page = browser.new_page(viewport={"width": 1400, "height": 900})
+    page.set_default_timeout(15000)
+    page.goto(url)
+    page.get_by_text("Metrics").first.wait_for(timeout=60000)
+    close = page.get_by_text("Software WebGL rendering detected")
+    try:  # the warning toast would cover part of the scene
+        close.wait_for(timeout=3000)
+        page.locator("button.mantine-Notification-closeButton").first.click()
+    except playwright.TimeoutError:
+        pass
+    # A short budget: two cores run the planner, the server and a software-rendering browser.
+    budget = page.get_by_label("Budget (iterations)")
+    budget.fill("4000")
+    budget.press("Enter")
+    wait_until(page, lambda img: asphalt(img) > 0.1)  # the track, once the view is fitted
+    wait_still(page)  # and the camera has stopped moving there
+    return page
+
+
+def asphalt(img: np.ndarray) -> float:
+    """Fraction of the view that is track surface, (60, 62, 72) once shaded."""
+    return float((img.sum(axis=2) < 300).mean())
+
+
+def wait_until(page, ok, timeout: float = 30.0) -> np.ndarray:
+    """Screenshots of the view until ``ok(pixels)``; the last one either way."""
+    deadline = time.monotonic() + timeout
+    while True:
+        img = canvas_pixels(page)
+        if ok(img) or time.monotonic() > deadline:
+            return img
+        time.sleep(0.3)
+
+
+def wait_still(page, timeout: float = 15.0) -> None:
+    """Until two screenshots half a second apart are the same."""
+    last, deadline = None, time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        time.sleep(0.5)
+        shot = page.screenshot(clip={"x": 0, "y": 0, "width": 960, "height": 900})
+        if shot == last:
+            return
+        last = shot
+
+
+def canvas_pixels(page, name: str | None = None) -> np.ndarray:
+    """The 3D view (left of the GUI panel) as an RGB array; saved as a PNG when named."""
+    from PIL import Image
+
+    png = page.screenshot(clip={"x": 0, "y": 0, "width": 960, "height": 900})
+    if name:
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        (ARTIFACTS / f"{name}.png").write_bytes(png)
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)
+
+
+def click(page, label: str) -> None:
+    # force: the panel's live content (metrics, plots) keeps shifting the layout by a few
+    # pixels, which Playwright's "stable element" check would wait out forever.
+    page.get_by_role("button", name=label, exact=True).click(force=True)
+
+
+def tree_pixels(img: np.ndarray) -> int:
+    """Pixels of the tree's blue (70, 150, 235), give or take antialiasing."""
+    return int((np.abs(img - [70, 150, 235]).sum(axis=2) < 60).sum())
+
+
+def metric(page, name: str) -> str:
+    """The value cell of a row of the Metrics table, as a number."""
+    cells = page.locator("tr", has_text=name).first.locator("td")
+    return float(cells.nth(1).inner_text().split()[0])
+
+
+def test_scene_renders_a_library_track_and_run_grows_the_tree(browser, ui_url):
+    page = open_tab(browser, ui_url)
+    before = canvas_pixels(page, "01_thesis_track")
+    assert asphalt(before) > 0.1, "the track surface is not drawn (blank canvas?)"
+    assert tree_pixels(before) < 50
+    click(page, "Run")
+    wait_until(page, lambda img: tree_pixels(img) > 2000, timeout=20)
+    time.sleep(1.0)
+    click(page, "Pause")  # a still tree: software WebGL redraws a growing one slowly
+    after = canvas_pixels(page, "02_thesis_running")
+    assert tree_pixels(after) > 2000, "Run drew no tree"
+    pink = (np.abs(after - [255, 90, 200]).sum(axis=2) < 60).sum()
+    assert pink > 200, "no best path drawn"
+    assert metric(page, "nodes") > 100
+    assert 9.0 < metric(page, "cost") < 30.0  # 3/4 of a 14 m lap
+    # The profile plots: uPlot canvases with the path drawn in them.
+    plots = page.locator(".uplot canvas")
+    assert plots.count() >= 3
+    box = plots.first.bounding_box()
+    assert box and box["width"] > 100 and box["height"] > 50
+    page.close()
+
+
+def test_step_highlights_a_line_of_extend_and_draws_the_iteration(browser, ui_url):
+    page = open_tab(browser, ui_url)
+    panel = page.locator("pre", has_text="SampleFree")
+    assert panel.locator("mark").count() == 0
+    before = canvas_pixels(page)
+    expected = {"SampleFree": "1", "blocked": "4", "joined via": "78"}
+    for n in range(1, 6):
+        click(page, "Step")
+        note = page.locator("p", has_text=f"Iteration {n}:")
+        note.wait_for(timeout=15000)
+        assert panel.locator("mark").count() == 1
+        line = panel.locator("mark").inner_text().strip()[0]
+        # The highlighted line is the one the explanation talks about.
+        said = [k for k in expected if k in note.inner_text()]
+        assert len(said) == 1 and line in expected[said[0]], (note.inner_text(), line)
+    after = canvas_pixels(page, "04_step")
+    assert np.abs(after - before).sum(axis=2).astype(bool).sum() > 100  # the step overlay
+    page.screenshot(path=str(ARTIFACTS / "05_extend_panel.png"))
+    page.close()
+
+
+SVG = """<svg xmlns="http://www.w3.org/2000/svg" width="200mm" height="120mm"
+ viewBox="0 0 200 120"><path id="loop" d="M 30 20 H 170 A 40 40 0 0 1 170 100 H 30
+ A 40 40 0 0 1 30 20 Z" style="stroke-width:8;fill:none"/>
+ <path id="road" d="M 10 60 L 190 60" style="stroke-width:8;fill:none"/></svg>"""
+
+
+def test_svg_upload_and_a_ground_click_change_the_track(browser, ui_url, tmp_path):
+    page = open_tab(browser, ui_url)
+    before = canvas_pixels(page)
+    svg = tmp_path / "two.svg"
+    svg.write_text(SVG)
+    page.locator("input[type=file]").first.set_input_files(str(svg))
+    page.get_by_text("SVG path").wait_for(timeout=20000)  # two paths: a choice appears
+    time.sleep(2.0)
+    click(page, "Fit view")
+    wait_still(page)
+    after = canvas_pixels(page, "06_svg_upload")
+    assert np.abs(after - before).sum(axis=2).astype(bool).mean() > 0.05
+    page.get_by_text("Draw a track").click()
+    page.get_by_text("Draw (click the ground)").click()
+    time.sleep(0.5)
+    page.mouse.click(400, 450)
+    page.get_by_text("— 1 points").wait_for(timeout=10000)
+    page.close()
+
+
+def test_two_tabs_are_independent_sessions(browser, ui_url):
+    a, b = open_tab(browser, ui_url), open_tab(browser, ui_url)
+    click(a, "Run")
+    assert tree_pixels(wait_until(a, lambda img: tree_pixels(img) > 2000, 20)) > 2000
+    click(a, "Pause")
+    assert tree_pixels(canvas_pixels(b, "07_second_tab")) < 50
+    assert b.locator("tr", has_text="iterations").count() == 0  # b never ran
+    a.close()
+    b.close()
