@@ -190,6 +190,35 @@ class Planner:
         return float(self._tree.cost[best]) if best >= 0 else None
 
     @property
+    def rewires(self) -> int:
+        return int(self._tree.cnt[K.REWIRES])
+
+    @property
+    def time_to_first_solution_s(self) -> float | None:
+        return self._clock.first_solution_s
+
+    @property
+    def poses(self) -> np.ndarray:
+        """A read-only *live* view of the nodes' poses: read it on the planner's thread (in a
+        listener); `snapshot()` gives a copy for anywhere else."""
+        view = self._tree.pose[: self.nodes]
+        view.flags.writeable = False
+        return view
+
+    def edge_points(self, node: int, count: int = 4) -> np.ndarray:
+        """(count + 1, 2) positions along the car path from ``node``'s parent to it (the root:
+        its position repeated), for drawing curved edges."""
+        t = self._tree
+        parent = int(t.parent[node])
+        if parent < 0:
+            return np.repeat(t.pose[node:node + 1, :2], count + 1, axis=0)
+        total = float(np.abs(t.lens[node]).sum())
+        dense = sample_path(*t.pose[parent], t.kinds[node], t.lens[node], self.problem.rho,
+                            max(total / (4 * count), 1e-6))
+        pick = np.linspace(0, len(dense) - 1, count + 1).round().astype(int)
+        return dense[pick, :2]
+
+    @property
     def finished(self) -> bool:
         """RRT is done at its first solution; RRT* goes on improving."""
         return self.settings.algorithm == "rrt" and self.solved

@@ -124,3 +124,12 @@ def test_k_nearest_variant_finds_valid_paths_and_rewires():
     assert result.solved and result.rewires > 0
     assert first_collision(scenario_dict("slalom"), result.path[:, :3]) is None
     assert result.settings.k_rrt == 5.5
+
+
+def test_live_poses_are_a_read_only_view_and_the_root_edge_is_a_dot():
+    problem = planner.compile_problem(planner.parse_scenario(scenario_dict("slalom")))
+    run = planner.Planner(problem)
+    run.step(300)
+    poses = run.poses
+    assert np.array_equal(poses, run.snapshot().pose) and not poses.flags.writeable
+    assert run.edge_points(0, 4) == pytest.approx(np.repeat(poses[:1, :2], 5, axis=0))

@@ -12,7 +12,7 @@ import planner
 from app.studio._custom import custom_scenario, track_from_points
 from app.studio._extend import LINES, StepInfo, explain, render
 from app.studio._scenario import default_scenario
-from app.studio._tree import EdgeChunks, edge_points
+from app.studio._tree import EdgeChunks
 
 
 def _problem(name: str = "thesis"):
@@ -36,15 +36,15 @@ def test_default_scenario_starts_on_the_track_heading_along_it(name):
 def test_edge_points_run_from_parent_to_node_along_the_tree():
     run = planner.Planner(_problem(), planner.PlannerSettings(seed=3))
     run.step(300)
-    tree = run._tree
+    snap = run.snapshot()
     for node in range(1, run.nodes):
-        pts = edge_points(tree, node, run.problem.rho)
+        pts = run.edge_points(node, 4)
         assert pts.shape == (5, 2)
-        parent = tree.parent[node]
-        assert np.allclose(pts[0], tree.pose[parent, :2], atol=1e-6)
-        assert np.allclose(pts[-1], tree.pose[node, :2], atol=1e-6)
+        assert np.allclose(pts[0], snap.pose[snap.parent[node], :2], atol=1e-6)
+        assert np.allclose(pts[-1], snap.pose[node, :2], atol=1e-6)
         # Consecutive samples along a car path never jump further than the edge is long.
-        assert np.hypot(*np.diff(pts, axis=0).T).sum() <= np.abs(tree.lens[node]).sum() + 1e-6
+        edge = snap.cost[node] - snap.cost[snap.parent[node]]
+        assert np.hypot(*np.diff(pts, axis=0).T).sum() <= edge + 1e-6
 
 
 def test_chunks_send_the_tail_every_time_and_rewired_chunks_a_few_at_a_time():

@@ -13,27 +13,11 @@ import threading
 
 import numpy as np
 
-from planner._paths import sample_path
 
-__all__ = ["CHUNK", "SEG", "EdgeChunks", "edge_points"]
+__all__ = ["CHUNK", "SEG", "EdgeChunks"]
 
 SEG = 4  # straight pieces per edge
 CHUNK = 256  # nodes per chunk
-
-
-def edge_points(tree, node: int, rho: float, seg: int = SEG) -> np.ndarray:
-    """(seg + 1, 2) points along the car path from ``node``'s parent to it (the root: a dot).
-
-    Reads the planner's tree arrays, so call it on the planner's thread (from a listener).
-    """
-    parent = int(tree.parent[node])
-    if parent < 0:
-        return np.repeat(tree.pose[node:node + 1, :2], seg + 1, axis=0)
-    total = float(np.abs(tree.lens[node]).sum())
-    dense = sample_path(*tree.pose[parent], tree.kinds[node], tree.lens[node], rho,
-                        max(total / (4 * seg), 1e-6))
-    pick = np.linspace(0, len(dense) - 1, seg + 1).round().astype(int)
-    return dense[pick, :2]
 
 
 class EdgeChunks:

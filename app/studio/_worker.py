@@ -17,7 +17,7 @@ import numpy as np
 
 import planner
 from app.studio._extend import StepInfo
-from app.studio._tree import EdgeChunks, edge_points
+from app.studio._tree import SEG, EdgeChunks
 from planner import _kernel as K
 from planner._world import path_clearances
 
@@ -130,18 +130,18 @@ class PlannerWorker:
 
     # -- the listener (planner thread) ---------------------------------------------------------
     def _on_events(self, ev: planner.TreeEvents | None) -> None:
-        tree, rho, live = self._run._tree, self._problem.rho, self.live
+        run, live = self._run, self.live
         if ev is None:
-            live.chunks.set(0, edge_points(tree, 0, rho))
+            live.chunks.set(0, run.edge_points(0, SEG))
             return
         for node in ev.rows[:, K.EV_NEW].astype(int):
             if node >= 0:
-                live.chunks.set(node, edge_points(tree, node, rho))
+                live.chunks.set(node, run.edge_points(node, SEG))
         now = time.monotonic()
         rewired = []
         for _, node, _, _ in ev.rewires:
             old = live.chunks.get(node)
-            new = edge_points(tree, node, rho)
+            new = run.edge_points(node, SEG)
             live.chunks.set(node, new)
             live.flashes.append((now, old, new))
             rewired.append((old, new))
@@ -151,7 +151,7 @@ class PlannerWorker:
 
     def _note_step(self, ev: planner.TreeEvents, rewired: list) -> None:
         row = ev.rows[-1]
-        pose = self._run._tree.pose
+        pose = self._run.poses
         info = StepInfo.from_row(row, len(rewired))
         near = ev.near[int(max(row[K.EV_NEAR_START], 0)):int(max(row[K.EV_NEAR_END], 0))]
         self.live.step = {
@@ -182,7 +182,7 @@ class PlannerWorker:
     def _metrics(self) -> dict:
         run = self._run
         return {"iterations": run.iterations, "nodes": run.nodes,
-                "rewires": int(run._tree.cnt[K.REWIRES]),
-                "time_to_first_solution_s": run._clock.first_solution_s,
+                "rewires": run.rewires,
+                "time_to_first_solution_s": run.time_to_first_solution_s,
                 "cost": run.best_cost, "min_clearance_m": self._clearance,
                 "iterations_per_s": self.iterations_per_s}
