@@ -31,9 +31,3 @@ def compiled_planner():
     from planner.rrt import warm_up
 
     warm_up()
-
-
-@pytest.fixture
-def scenarios_dir() -> Path:
-    assert SCENARIOS.is_dir(), f"reference scenarios not found at {SCENARIOS}"
-    return SCENARIOS
