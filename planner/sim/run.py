@@ -3,29 +3,31 @@
 Control ticks at ``control_rate`` drive the clock. A replanning cycle that starts at tick time t
 hands its plan over at t + max(1/rate, its measured wall time) — or the fixed latency — and the
 next cycle starts then; until then the car follows the committed trajectory. The simulation is
-not paced to the wall clock unless ``realtime``.
+not paced to the wall clock unless ``realtime``. An optional observer receives a `Frame` per
+control tick (for a live view); without one, nothing is built.
 """
 
 from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
 from planner._world import path_clearances
 from planner.problem import Problem, compile_problem
-from planner.rrt import PlannerSettings, warm_up
+from planner.rrt import Planner, PlannerSettings, warm_up
 from planner.scenario import Scenario
-from planner.sim.control import CONTROLLERS, Tracking, steer_command
+from planner.sim.control import CONTROLLERS, Reference, Tracking, steer_command
 from planner.sim.metrics import collision_runs, cycle_stats
 from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
-from planner.sim.sensing import mover_index, sense, true_offsets
+from planner.sim.sensing import Sensing, mover_index, sense, true_offsets
 from planner.sim.vehicle import Limits, arc_step, limit_commands
 
-__all__ = ["SimRun", "SimSettings", "simulate"]
+__all__ = ["Frame", "SimRun", "SimSettings", "simulate"]
 
 
 @dataclass(frozen=True)
@@ -77,6 +79,30 @@ class SimRun:
                    fmt="%.12g")
 
 
+@dataclass(frozen=True)
+class Frame:
+    """One control tick as a viewer sees it: the truth, what the car believes, what it does.
+
+    ``reference`` and ``planner`` are the live objects, not copies: a cycle builds new ones and
+    never changes them afterwards, so they may be read until the next frame arrives (the
+    planner's tree on the simulation's thread, i.e. inside the observer).
+    """
+
+    t: float
+    pose: tuple[float, float, float]  # true rear-axle pose (m, m, rad)
+    v: float  # speed command held over [t, t + Δt)
+    steer: float  # steering angle commanded (after the limits), rad
+    steer_set: float  # steering angle the controller wanted (Soll), rad
+    lateral_error: float  # m from the committed trajectory, left positive (NaN: none yet)
+    offsets: np.ndarray  # (n_obstacles, 2) true offsets at t, scenario order
+    sensing: Sensing | None  # latest sensed offsets and velocities, motion order
+    reference: Reference | None  # the committed trajectory the car tracks
+    planner: Planner | None  # the replanner's current tree
+    cycles: int
+    replans: int
+    cycle_ms: float  # wall time of the latest cycle (NaN before the first)
+
+
 def _in_goal(problem: Problem, x: float, y: float, th: float) -> bool:
     gx, gy, gth = problem.goal
     return (math.hypot(x - gx, y - gy) <= problem.goal_position_tol
@@ -84,8 +110,13 @@ def _in_goal(problem: Problem, x: float, y: float, th: float) -> bool:
 
 
 def simulate(scenario: Scenario, settings: SimSettings | None = None,
-             problem: Problem | None = None) -> SimRun:
-    """Drive the scenario's car to its goal; raises ScenarioError / ValueError on bad input."""
+             problem: Problem | None = None,
+             observer: Callable[[Frame], None] | None = None) -> SimRun:
+    """Drive the scenario's car to its goal; raises ScenarioError / ValueError on bad input.
+
+    ``observer`` gets a `Frame` per control tick, on this thread; an exception it raises ends
+    the run (and propagates).
+    """
     s = settings or SimSettings()
     problem = problem or compile_problem(scenario)
     warm_up()
@@ -158,6 +189,11 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
         rows.append((t, x, y, th, v_cmd, steer_cmd, want_steer, e,
                      replanner.planner.nodes if replanner.planner else 0))
         lat.append(abs(e))
+        if observer is not None:
+            observer(Frame(t, (x, y, th), v_cmd, steer_cmd, want_steer, e,
+                           true_offsets(problem.world, movers, t)[0], sensing, ref,
+                           replanner.planner, len(cycles), int(replans),
+                           cycles[-1]["ms"] if cycles else math.nan))
         v, steer = v_cmd, steer_cmd
         if _in_goal(problem, x, y, th):
             reached = True
