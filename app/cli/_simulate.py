@@ -41,12 +41,11 @@ def simulate(
     with user_errors():
         if laps is not None:
             raise ValueError("--laps: lap mode is not implemented yet")
+        machine = None
         if behaviour is not None:
             from planner.sim.fsm import load_fsm
 
-            load_fsm(behaviour)  # a bad file is reported first, naming the element
-            raise ValueError("--behaviour: running a state machine is not implemented yet "
-                             "(trackstar fsm check validates the file)")
+            machine = load_fsm(behaviour)  # a bad file is reported first, naming the element
         settings = SimSettings(duration=duration, rate=rate, control_rate=control_rate,
                                sense_rate=sense_rate, controller=controller, noise=noise,
                                seed=seed, fixed_latency_ms=fixed_latency,
@@ -54,7 +53,7 @@ def simulate(
         problem = core.compile_problem(core.load_scenario(scenario))
         if log is not None and not log.parent.is_dir():
             raise ValueError(f"--log: directory {str(log.parent)!r} does not exist")
-        result = run_simulation(problem.scenario, settings, problem)
+        result = run_simulation(problem.scenario, settings, problem, behaviour=machine)
         if log is not None:
             result.write_log(log)
     summary = result.summary
@@ -72,6 +71,10 @@ def _print_summary(name: str, s: dict) -> None:
     goal = (f"goal reached at t = {s['time_to_goal_s']:.2f} s" if s["reached_goal"]
             else f"goal not reached in {s['duration_s']:.1f} s")
     typer.echo(f"{name}: {goal}, {s['distance_m']:.2f} m driven")
+    if "behaviour" in s:
+        b = s["behaviour"]
+        typer.echo(f"  behaviour: {len(b['transitions'])} transitions, "
+                   f"final state '{b['final_state']}'")
     typer.echo(f"  collisions {s['collisions']}, min clearance {s['min_clearance_m']:.3f} m, "
                f"emergency stops {s['emergency_stops']}")
     c = s["cycle_ms"]

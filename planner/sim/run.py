@@ -21,6 +21,8 @@ from planner.problem import Problem, compile_problem
 from planner.rrt import Planner, PlannerSettings, warm_up
 from planner.scenario import Scenario
 from planner.sim.control import CONTROLLERS, Reference, Tracking, steer_command
+from planner.sim.fsm import Machine
+from planner.sim.fsm.runtime import Behaviour
 from planner.sim.metrics import collision_runs, cycle_stats
 from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
@@ -111,11 +113,13 @@ def _in_goal(problem: Problem, x: float, y: float, th: float) -> bool:
 
 def simulate(scenario: Scenario, settings: SimSettings | None = None,
              problem: Problem | None = None,
-             observer: Callable[[Frame], None] | None = None) -> SimRun:
+             observer: Callable[[Frame], None] | None = None,
+             behaviour: Machine | None = None) -> SimRun:
     """Drive the scenario's car to its goal; raises ScenarioError / ValueError on bad input.
 
     ``observer`` gets a `Frame` per control tick, on this thread; an exception it raises ends
-    the run (and propagates).
+    the run (and propagates). ``behaviour``: a state machine drives instead of the planner's
+    goal; the replanner runs only while its current state is FollowTrack.
     """
     s = settings or SimSettings()
     problem = problem or compile_problem(scenario)
@@ -128,19 +132,23 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     movers = mover_index(scenario)
     rng = np.random.default_rng(s.seed)
     fixed = s.fixed_latency_ms / 1000.0 if s.fixed_latency_ms is not None else None
-    replanner = Replanner(problem, PlannerSettings(seed=s.seed), seed=s.seed,
-                          budget_s=s.budget_share / s.rate,
-                          iterations=s.iterations if fixed is not None else None,
-                          margin=s.margin)
+    def new_replanner() -> Replanner:
+        return Replanner(problem, PlannerSettings(seed=s.seed), seed=s.seed,
+                         budget_s=s.budget_share / s.rate,
+                         iterations=s.iterations if fixed is not None else None,
+                         margin=s.margin)
+
+    replanner = new_replanner()
+    fsm = Behaviour(behaviour, problem.world, limits.wheelbase, dt) if behaviour else None
     gains = Tracking()
-    cruise = vehicle.speed
+    cruise = vehicle.speed if fsm is None else limits.max_speed  # FollowTrack caps its own
     x, y, th = problem.start
     est = (x, y, th)
     v = steer = 0.0
     e_old = math.nan
     sensing, j_sense = None, 0
     ref, stop_s, conflict = None, 0.0, False
-    pending, next_cycle = None, 0.0
+    pending, next_cycle = None, 0.0 if fsm is None or fsm.planning else math.inf
     walls, cycles, replans, stops, was_stopped = [], [], 0, 0, False
     rows, lat = [], []
     wall0 = time.perf_counter()
@@ -181,6 +189,12 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
             want_v = min(cruise, math.sqrt(2.0 * limits.max_accel * max(room, 0.0)))
             want_steer = steer_command(s.controller, ref, i, e, e_old, est, v,
                                        limits.wheelbase, dt, gains)
+        if fsm is not None:  # the state machine drives; FollowTrack passes the plan on
+            want_v, want_steer = fsm.step(t, (x, y, th), est, v, steer,
+                                          (want_v, want_steer) if ref is not None else None)
+            if fsm.planner_switched:  # FollowTrack entered or left: plan afresh from here
+                replanner, ref, pending, conflict = new_replanner(), None, None, False
+                next_cycle = t + dt if fsm.planning else math.inf
         v_cmd, steer_cmd = limit_commands(v, steer, want_v, want_steer, limits, dt)
         e_old = e
         stopped = ref is not None and conflict and abs(v_cmd) < 1e-9
@@ -197,6 +211,8 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
         v, steer = v_cmd, steer_cmd
         if _in_goal(problem, x, y, th):
             reached = True
+            break
+        if fsm is not None and fsm.done(v):  # the machine's Stop reached, at rest
             break
         if k == n_ticks:
             break
@@ -231,4 +247,8 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
         "distance_m": float(np.abs(log[:, 4]).sum() * dt) - float(abs(log[-1, 4]) * dt),
         "parameters": asdict(s),
     }
+    if fsm is not None:
+        columns.append("state")  # index into summary["behaviour"]["states"]
+        table = np.column_stack([table, fsm.trace])
+        summary["behaviour"] = fsm.report()
     return SimRun(summary, columns, table, cycles)
