@@ -15,7 +15,7 @@ import numpy as np
 from planner._world import World, build_world, pose_clearance
 from planner.scenario import Box, Circle, Scenario, ScenarioError
 
-__all__ = ["Problem", "compile_problem"]
+__all__ = ["Problem", "compile_problem", "resolve_track"]
 
 
 @dataclass(frozen=True)
@@ -42,7 +42,8 @@ class Problem:
         return float(pose_clearance(self.world, x, y, theta, t))
 
 
-def _track_region(scenario: Scenario, load_track):
+def resolve_track(scenario: Scenario, load_track=None):
+    """The scenario's track: ``load_track(name)`` (default: the library), at its width."""
     if load_track is None:
         import tracks  # imported lazily: a track is optional, and tracks needs svg libraries
 
@@ -73,7 +74,7 @@ def compile_problem(scenario: Scenario, load_track=None) -> Problem:
     ``load_track(name) -> tracks.Track`` resolves ``scenario.track.name`` (default: the track
     library); the server passes one that also knows uploaded tracks.
     """
-    track = _track_region(scenario, load_track) if scenario.track is not None else None
+    track = resolve_track(scenario, load_track) if scenario.track is not None else None
     rings = track.region_rings() if track is not None else []
     if scenario.bounds is not None:
         bounds = scenario.bounds

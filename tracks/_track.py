@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -69,6 +69,10 @@ class Track:
     @property
     def length_m(self) -> float:
         return self.table.length
+
+    def with_width(self, width_m: float) -> Track:
+        """The same centreline at another width (a scenario's ``track.width_m``)."""
+        return replace(self, width_m=width_m)
 
     def points_at(self, s: np.ndarray) -> np.ndarray:
         """World points (n, 2) at arc lengths ``s`` from the start (clipped to the track)."""

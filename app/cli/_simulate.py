@@ -19,8 +19,11 @@ def simulate(
     control_rate: Annotated[float, typer.Option(help="Control ticks per second.")] = 100.0,
     sense_rate: Annotated[float, typer.Option(help="Sensing instants per second.")] = 10.0,
     controller: Annotated[str, typer.Option(help="pure-pursuit, stanley or pd.")] = "pure-pursuit",
-    noise: Annotated[float, typer.Option(help="σ (m) of sensed positions.")] = 0.0,
-    laps: Annotated[int | None, typer.Option(help="Drive N laps of the scenario's track.")] = None,
+    noise: Annotated[float, typer.Option(
+        help="σ (m) of sensed positions; the sensed heading gets √2·σ/wheelbase (rad).")] = 0.0,
+    laps: Annotated[int | None, typer.Option(
+        help="Drive N laps of the scenario's closed track (rich schema) behind a rolling goal; "
+             "the scenario's goal is not used.")] = None,
     behaviour: Annotated[Path | None, typer.Option(help="Drive by this state machine (JSON).")]
     = None,
     seed: Annotated[int, typer.Option(help="Random seed (planner and noise).")] = 0,
@@ -39,8 +42,6 @@ def simulate(
     from planner.sim import simulate as run_simulation
 
     with user_errors():
-        if laps is not None:
-            raise ValueError("--laps: lap mode is not implemented yet")
         machine = None
         if behaviour is not None:
             from planner.sim.fsm import load_fsm
@@ -49,7 +50,7 @@ def simulate(
         settings = SimSettings(duration=duration, rate=rate, control_rate=control_rate,
                                sense_rate=sense_rate, controller=controller, noise=noise,
                                seed=seed, fixed_latency_ms=fixed_latency,
-                               replan=not no_replan, realtime=realtime)
+                               replan=not no_replan, realtime=realtime, laps=laps)
         problem = core.compile_problem(core.load_scenario(scenario))
         if log is not None and not log.parent.is_dir():
             raise ValueError(f"--log: directory {str(log.parent)!r} does not exist")

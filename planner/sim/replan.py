@@ -69,6 +69,13 @@ class Replanner:
         self.root_s = 0.0  # arc of the planner's root on the reference
         self.reference: Reference | None = None
         self.count = 0
+        self.goals: list = []
+
+    def aim(self, goals) -> None:
+        """Lap mode's rolling goal: from the next cycle on, plan towards the first of ``goals``
+        (poses, best first) that the believed world leaves free — a goal on an obstacle would
+        leave the car without a plan. Kept goal nodes are re-registered when re-rooting."""
+        self.goals = list(goals)
 
     # -- the cycle ---------------------------------------------------------------------------
     def cycle(self, t: float, sensing: Sensing, pose, v: float, s_now: float,
@@ -84,13 +91,18 @@ class Replanner:
         if clearance(plan_world, root[0], root[1], 0.0) <= 0.0:
             plan_world = believed  # already inside the margin: plan with the bare disc
         self._s_c = s_c
+        if self.goals:
+            free = [g for g in self.goals if clearance(plan_world, g[0], g[1], 0.0) > 0.0]
+            self.problem = dataclasses.replace(self.problem, goal=(free or self.goals)[0])
         old, old_cost = self.planner, self._remaining_cost(s_c)
         planner = self._new_planner(plan_world, root, old, anchor, skip)
         self._grow(planner, started)
         replaced = False
         self.shift = 0.0
         if planner.solved:
-            replaced = not (self.attached and abs(planner.best_cost - old_cost) < 1e-9)
+            # The first plan replaces nothing; later ones do unless the tree kept the old one.
+            replaced = self.reference is not None and not (
+                self.attached and abs(planner.best_cost - old_cost) < 1e-9)
             path = planner.dense_path(SPACING)[:, :5]
             self.reference = self._joined(s_c, path, s_now)
             self.attached, self.planner = True, planner

@@ -17,12 +17,13 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from planner._world import path_clearances
-from planner.problem import Problem, compile_problem
+from planner.problem import Problem, compile_problem, resolve_track
 from planner.rrt import Planner, PlannerSettings, warm_up
 from planner.scenario import Scenario
 from planner.sim.control import CONTROLLERS, Reference, Tracking, steer_command
 from planner.sim.fsm import Machine
 from planner.sim.fsm.runtime import Behaviour
+from planner.sim.laps import LapCounter
 from planner.sim.metrics import collision_runs, cycle_stats
 from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
@@ -41,7 +42,7 @@ class SimSettings:
     control_rate: float = 100.0
     sense_rate: float = 10.0
     controller: str = "pure-pursuit"
-    noise: float = 0.0  # σ (m) of sensed positions
+    noise: float = 0.0  # σ (m) of sensed positions; the heading gets √2·σ / wheelbase (rad)
     seed: int = 0
     fixed_latency_ms: float | None = None  # a fixed cycle time instead of the measured one
     replan: bool = True  # False: one plan at t = 0, followed blind
@@ -49,6 +50,8 @@ class SimSettings:
     iterations: int = 80  # planner iterations per cycle under a fixed latency
     margin: float = 0.05  # m added to the car's radius when planning
     realtime: bool = False
+    laps: int | None = None  # lap mode: drive this many laps of the scenario's closed track
+    goal_ahead: float = 3.0  # m of centreline arc between the car and its rolling goal (laps)
 
     def __post_init__(self) -> None:
         for name in ("duration", "rate", "control_rate", "sense_rate"):
@@ -61,6 +64,8 @@ class SimSettings:
                              f"(use one of {', '.join(CONTROLLERS)})")
         if not (math.isfinite(self.noise) and self.noise >= 0):
             raise ValueError(f"--noise must be a finite number >= 0, got {self.noise}")
+        if self.laps is not None and self.laps < 1:
+            raise ValueError(f"--laps must be at least 1, got {self.laps}")
         if self.fixed_latency_ms is not None and not (
                 math.isfinite(self.fixed_latency_ms) and self.fixed_latency_ms >= 0):
             raise ValueError(f"--fixed-latency must be a finite number >= 0, "
@@ -111,8 +116,19 @@ def _in_goal(problem: Problem, x: float, y: float, th: float) -> bool:
             and abs(math.remainder(th - gth, 2.0 * math.pi)) <= problem.goal_heading_tol)
 
 
+def _lap_counter(scenario: Scenario, problem: Problem, s: SimSettings, load_track):
+    """Lap mode's counter and rolling goal (None in goal mode). Replanning off cannot mean one
+    plan for N laps: the cycles go on extending the path, but on the t = 0 sensing alone."""
+    if s.laps is None:
+        return None
+    if scenario.track is None:
+        raise ValueError("--laps needs a scenario with a closed track "
+                         "(rich schema, e.g. \"track\": {\"name\": \"thesis\"})")
+    return LapCounter(resolve_track(scenario, load_track), problem.start, s.goal_ahead)
+
+
 def simulate(scenario: Scenario, settings: SimSettings | None = None,
-             problem: Problem | None = None,
+             problem: Problem | None = None, load_track=None,
              observer: Callable[[Frame], None] | None = None,
              behaviour: Machine | None = None) -> SimRun:
     """Drive the scenario's car to its goal; raises ScenarioError / ValueError on bad input.
@@ -141,6 +157,9 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     replanner = new_replanner()
     fsm = Behaviour(behaviour, problem.world, limits.wheelbase, dt) if behaviour else None
     gains = Tracking()
+    counter = _lap_counter(scenario, problem, s, load_track)
+    # Heading noise as if θ came from two position fixes a wheelbase apart.
+    pose_sigma = (s.noise, s.noise, math.sqrt(2.0) * s.noise / limits.wheelbase)
     cruise = vehicle.speed if fsm is None else limits.max_speed  # FollowTrack caps its own
     x, y, th = problem.start
     est = (x, y, th)
@@ -157,9 +176,10 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
         t = k * dt
         while j_sense / s.sense_rate <= t + 1e-9:  # sensing instants up to now
             ts = j_sense / s.sense_rate
-            sensing = sense(problem.world, movers, ts, s.sense_rate, s.noise, rng)
-            noise = rng.normal(0.0, s.noise, 2) if s.noise > 0 else (0.0, 0.0)
-            est = (x + noise[0], y + noise[1], th)
+            if s.replan or sensing is None:  # replanning off: the car knows only t = 0
+                sensing = sense(problem.world, movers, ts, s.sense_rate, s.noise, rng)
+            noise = rng.normal(0.0, pose_sigma) if s.noise > 0 else (0.0, 0.0, 0.0)
+            est = (x + noise[0], y + noise[1], th + noise[2])
             j_sense += 1
         if pending is not None and pending[0] <= t + 1e-9:
             cyc = pending[1]
@@ -168,7 +188,10 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
             stop_s, conflict = cyc.stop_s, cyc.conflict and s.replan
             replans += cyc.replaced
             pending = None
-        if pending is None and t >= next_cycle - 1e-9 and (s.replan or ref is None):
+        if pending is None and t >= next_cycle - 1e-9 and (
+                s.replan or ref is None or counter is not None):
+            if counter is not None:
+                replanner.aim(counter.goals())
             s_now = ref.s[ref.project(est[0], est[1])[0]] if ref is not None else 0.0
             lead = max(1.0 / s.rate, fixed if fixed is not None else
                        (walls[-1] if walls else 0.0))
@@ -209,7 +232,9 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                            replanner.planner, len(cycles), int(replans),
                            cycles[-1]["ms"] if cycles else math.nan))
         v, steer = v_cmd, steer_cmd
-        if _in_goal(problem, x, y, th):
+        if counter is not None:
+            counter.update(t, x, y)
+        if (counter.laps >= s.laps) if counter is not None else _in_goal(problem, x, y, th):
             reached = True
             break
         if fsm is not None and fsm.done(v):  # the machine's Stop reached, at rest
@@ -247,6 +272,8 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
         "distance_m": float(np.abs(log[:, 4]).sum() * dt) - float(abs(log[-1, 4]) * dt),
         "parameters": asdict(s),
     }
+    if counter is not None:
+        summary.update(laps=counter.laps, lap_times_s=counter.lap_times)
     if fsm is not None:
         columns.append("state")  # index into summary["behaviour"]["states"]
         table = np.column_stack([table, fsm.trace])
