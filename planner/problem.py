@@ -15,7 +15,7 @@ import numpy as np
 from planner._world import World, build_world, pose_clearance
 from planner.scenario import Box, Circle, Scenario, ScenarioError
 
-__all__ = ["Problem", "compile_problem", "resolve_track"]
+__all__ = ["Problem", "compile_problem", "follow_waypoints", "resolve_track"]
 
 
 @dataclass(frozen=True)
@@ -43,13 +43,16 @@ class Problem:
 
 
 def resolve_track(scenario: Scenario, load_track=None):
-    """The scenario's track: ``load_track(name)`` (default: the library), at its width."""
-    if load_track is None:
-        import tracks  # imported lazily: a track is optional, and tracks needs svg libraries
+    """The scenario's track: embedded SVG, else ``load_track(name)`` (default: the library)."""
+    import tracks  # imported lazily: a track is optional, and tracks needs svg libraries
 
+    if load_track is None:
         load_track = tracks.load_library_track
     try:
-        track = load_track(scenario.track.name)
+        if scenario.track.svg is not None:
+            track = tracks.load_svg(scenario.track.svg.encode())
+        else:
+            track = load_track(scenario.track.name)
     except (KeyError, ValueError) as exc:
         raise ScenarioError(f"track: {exc}") from None
     if scenario.track.width_m is not None:
@@ -57,7 +60,7 @@ def resolve_track(scenario: Scenario, load_track=None):
     return track
 
 
-def _follow_waypoints(track, follow, step_s: float = 0.05) -> np.ndarray:
+def follow_waypoints(track, follow, step_s: float = 0.05) -> np.ndarray:
     """A track-following motion as dense timed offsets from its position at t = 0."""
     prof = track.sample(spacing=0.02)
     times = np.arange(0.0, follow.horizon_s + step_s, step_s)
@@ -92,7 +95,7 @@ def compile_problem(scenario: Scenario, load_track=None) -> Problem:
             elif ob.motion.waypoints is not None:
                 motions.append(("waypoints", ob.motion.waypoints))
             else:
-                motions.append(("waypoints", _follow_waypoints(track, ob.motion.follow_track)))
+                motions.append(("waypoints", follow_waypoints(track, ob.motion.follow_track)))
         if isinstance(ob, Circle):
             circles.append((*ob.center, ob.radius, m))
         elif isinstance(ob, Box):

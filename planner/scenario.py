@@ -173,10 +173,13 @@ Obstacle = Annotated[Circle | Polygon | Box, Field(discriminator="type")]
 
 
 class TrackRef(_Strict):
-    """A library track as the drivable region (rich schema)."""
+    """The drivable region (rich schema): a library track by name, or any track embedded as
+    the Inkscape SVG `Track.to_svg` writes, so a scenario drawn or uploaded in the studio is
+    self-contained (``name`` then only labels it)."""
 
     name: str
     width_m: Positive | None = None
+    svg: str | None = None
 
 
 class Scenario(_Strict):

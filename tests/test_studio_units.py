@@ -3,16 +3,20 @@ drawn tracks — each against a real planner run, not hand-made numbers."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 import pytest
 
 import planner
-from app.studio._custom import custom_scenario, track_from_points
+from app.studio._actions import parse_waypoints
+from app.studio._custom import Draft, custom_scenario
+from app.studio._edit import moved_obstacle
 from app.studio._extend import LINES, StepInfo, explain, render
 from app.studio._scenario import default_scenario
 from app.studio._tree import EdgeChunks
+from planner.problem import resolve_track
 
 
 def _problem(name: str = "thesis"):
@@ -110,12 +114,22 @@ def test_rrt_without_star_ends_on_the_insert_line():
     assert explain(info, star=False)[0] == 6
 
 
-def test_a_drawn_loop_becomes_a_plannable_scenario():
-    track = track_from_points([(0, 0), (4, 0), (5, 3), (1, 4), (-1, 2)], 0.8, closed=True)
-    scenario, region = custom_scenario(track, "drawn")
-    problem = planner.compile_problem(planner.parse_scenario(
-        dict(scenario, obstacles=region)))
-    result = planner.solve(problem, time_limit=None, iterations=20000, seed=0)
+def _draft(points) -> Draft:
+    d = Draft()
+    for p in points:
+        d.add(p)
+    return d
+
+
+def test_a_drawn_loop_embedded_in_its_scenario_is_plannable_and_loads_back():
+    track = _draft([(0, 0), (4, 0), (5, 3), (1, 4), (-1, 2)]).track(0.8, closed=True)
+    scenario = custom_scenario(track, "drawn")
+    parsed = planner.parse_scenario(json.loads(json.dumps(scenario)))  # as saved
+    again = resolve_track(parsed)
+    assert again.length_m == pytest.approx(track.length_m, rel=1e-6)
+    assert again.width_m == pytest.approx(0.8)
+    result = planner.solve(planner.compile_problem(parsed), time_limit=None, iterations=20000,
+                           seed=0)
     assert result.solved
     # The path stays on the drawn track: every sample within half a width of the centreline.
     prof = track.sample(0.02)
@@ -124,6 +138,37 @@ def test_a_drawn_loop_becomes_a_plannable_scenario():
     assert d.max() <= track.width_m / 2 + 0.02
 
 
+def test_drawn_points_get_catmull_rom_handles_until_one_is_dragged():
+    d = _draft([(0, 0), (1, 0), (2, 1), (3, 1)])
+    assert np.allclose(d.handle(1, closed=False), (np.array([2, 1]) - [0, 0]) / 6)
+    first = d.beziers(closed=False)[0]
+    assert np.allclose(first[[0, 3]], [[0, 0], [1, 0]])  # through the clicked points
+    d.handles[1] = np.array([0.0, 0.5])  # dragged: the tangent at point 1 turns up
+    a, b = d.beziers(closed=False)[:2]
+    assert np.allclose(a[2], [1, -0.5]) and np.allclose(b[1], [1, 0.5])  # mirrored: smooth
+    svg = d.track(0.5, closed=False).to_svg()
+    assert svg.count(" C ") == 3  # real cubic Béziers in the download
+
+
 def test_too_few_drawn_points_are_refused():
     with pytest.raises(ValueError, match="at least 3"):
-        track_from_points([(0, 0), (1, 0)], 0.5, closed=True)
+        _draft([(0, 0), (1, 0)]).track(0.5, closed=True)
+
+
+def test_a_dragged_obstacle_keeps_its_shape_and_turns_about_its_centre():
+    poly = {"type": "polygon", "points": [[0, 0], [2, 0], [2, 1], [0, 1]]}
+    parsed = planner.parse_scenario({"name": "p", "bounds": [-5, -5, 5, 5], "start": [0, 0, 0],
+                                     "goal": [1, 1, 0], "obstacles": [poly]}).obstacles[0]
+    moved = moved_obstacle(poly, parsed, 3.0, 2.0, math.pi / 2, None)
+    pts = np.array(moved["points"])
+    assert np.allclose(pts.mean(axis=0), [3, 2])
+    assert np.allclose(np.ptp(pts, axis=0), [1, 2])  # turned a quarter
+    box = {"type": "box", "center": [0, 0], "size": [1, 0.5]}
+    assert moved_obstacle(box, None, 1, 2, math.radians(30), None) == {
+        "type": "box", "center": [1, 2], "size": [1, 0.5], "angle_deg": 30.0}
+
+
+def test_waypoints_text_is_rows_of_t_dx_dy():
+    assert parse_waypoints("0 0 0; 3 0.5 0\n6, 1, 1") == [[0, 0, 0], [3, 0.5, 0], [6, 1, 1]]
+    with pytest.raises(ValueError, match="t dx dy"):
+        parse_waypoints("0 0; 1 1 1")

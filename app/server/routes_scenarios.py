@@ -29,7 +29,8 @@ def resolve(request: Request, body: dict[str, Any] | str) -> tuple[dict, TrackSo
     if isinstance(body, str):
         body = stored_scenario(request, body)["scenario"]
     scenario = planner.parse_scenario(body)
-    if scenario.track is None or scenario.track.name in tracks.library_names():
+    if (scenario.track is None or scenario.track.svg is not None
+            or scenario.track.name in tracks.library_names()):
         return body, None
     row = request.app.state.store.track(scenario.track.name)
     if row is None:

@@ -9,17 +9,19 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import re
 
 import httpx
 import numpy as np
 
 import planner
 import tracks
-from app.studio._custom import custom_scenario, track_from_points
+from app.studio._custom import Draft, custom_scenario
+from app.studio._edit import click_mode, draft_changed, nearest_s, show_gizmos, show_polygon
 from app.studio._panel import SPEEDS
-from app.studio._scene import Z, polyline_segments
+from planner.problem import resolve_track
 
-__all__ = ["drive_step", "load_scenario", "wire"]
+__all__ = ["add_obstacle", "load_scenario", "parse_waypoints", "wire"]
 
 
 def wire(s) -> None:
@@ -28,14 +30,19 @@ def wire(s) -> None:
     u.svg_upload.on_upload(lambda _: _svg_uploaded(s))
     u.svg_path.on_update(lambda _: _svg_path_chosen(s))
     u.fit.on_click(lambda _: s.fit())
-    u.draw.on_update(lambda _: _draw_mode(s))
-    u.draw_undo.on_click(lambda _: _draft_changed(s, s.draft[:-1]))
+    u.draw.on_update(lambda _: click_mode(s, "track"))
+    u.draw_undo.on_click(lambda _: (s.draft.undo(), draft_changed(s)))
+    u.draw_close.on_update(lambda _: draft_changed(s))
     u.draw_use.on_click(lambda _: _use_drawn(s))
     u.draw_download.on_click(lambda _: _download_svg(s))
     u.add_circle.on_click(lambda _: _add_obstacle(s, "circle"))
     u.add_box.on_click(lambda _: _add_obstacle(s, "box"))
+    u.polygon.on_update(lambda _: click_mode(s, "polygon"))
+    u.close_polygon.on_click(lambda _: _close_polygon(s))
     u.clear_obstacles.on_click(lambda _: s.apply_scenario(dict(s.scenario, obstacles=[])))
-    u.scene_time.on_update(lambda _: s.draw_scenario(u.scene_time.value))
+    u.handles.on_update(lambda _: show_gizmos(s))
+    u.set_motion.on_click(lambda _: _set_motion(s))
+    u.scene_time.on_update(lambda _: s.show_time(u.scene_time.value))
     u.scenario_download.on_click(lambda _: s.client.send_file_download(
         f"{u.scenario_name.value or 'studio'}.json", s.scenario_json().encode()))
     u.scenario_upload.on_upload(lambda _: _scenario_uploaded(s))
@@ -49,7 +56,7 @@ def wire(s) -> None:
     u.pause.on_click(lambda _: s.worker.pause())
     u.step.on_click(lambda _: s.worker.step())
     u.reset.on_click(lambda _: s.reset())
-    u.drive.on_click(lambda _: _start_drive(s))
+    u.drive.on_click(lambda _: s.drive())
 
 
 # -- tracks -----------------------------------------------------------------------------------
@@ -86,47 +93,14 @@ def _svg_path_chosen(s) -> None:
 
 def _use_track(s, track: tracks.Track) -> None:
     try:
-        scenario, region = custom_scenario(track, track.name or "custom")
-        s.set_track(track, scenario, region)
+        s.set_track(track, custom_scenario(track, track.name or "custom"))
     except (planner.ScenarioError, ValueError, tracks.TrackError) as exc:
         s.notify("Track not usable", str(exc))
 
 
-def _draw_mode(s) -> None:
-    if s.ui.draw.value:
-        s.scene.on_click()(lambda ev: _ground_click(s, ev))
-    else:
-        s.scene.remove_click_callback("all")
-
-
-def _ground_click(s, ev) -> None:
-    """Where the click ray meets the ground plane z = 0 becomes the next track point."""
-    (ox, oy, oz), (dx, dy, dz) = ev.ray_origin, ev.ray_direction
-    if abs(dz) < 1e-9 or -oz / dz < 0:
-        return
-    t = -oz / dz
-    _draft_changed(s, [*s.draft, (ox + t * dx, oy + t * dy)])
-
-
-def _draft_changed(s, draft: list) -> None:
-    s.draft = draft
-    pts = np.array(draft, dtype=float).reshape(-1, 2)
-    m = s.marker()
-    dots = [polyline_segments(p + m * np.array([[-1, -1], [1, 1], [-1, 1], [1, -1]]), Z["pose"])
-            [[0, 2]] for p in pts]
-    with s.client.atomic():
-        s.scene.add_line_segments(
-            "/draft/points", np.concatenate(dots) if dots else np.zeros((0, 2, 3)),
-            (255, 120, 0), thickness=3.0, thickness_units="screen", visible=bool(dots))
-        line = polyline_segments(pts, Z["pose"]) if len(pts) > 1 else np.zeros((0, 2, 3))
-        s.scene.add_line_segments("/draft/line", line, (255, 120, 0), thickness=1.5,
-                                  thickness_units="screen", visible=len(line) > 0)
-    s.ui.draw.label = f"Draw (click the ground) — {len(draft)} points"
-
-
 def _drawn_track(s) -> tracks.Track | None:
     try:
-        return track_from_points(s.draft, float(s.ui.draw_width.value), s.ui.draw_close.value)
+        return s.draft.track(float(s.ui.draw_width.value), bool(s.ui.draw_close.value))
     except (ValueError, tracks.TrackError) as exc:
         s.notify("Track not drawn", str(exc))
         return None
@@ -137,11 +111,12 @@ def _use_drawn(s) -> None:
     if track is not None:
         s.ui.draw.value = False
         _use_track(s, track)
-        s.draft = []
+        s.draft = Draft()
+        draft_changed(s)
 
 
 def _download_svg(s) -> None:
-    track = _drawn_track(s) if s.draft else s.track
+    track = _drawn_track(s) if s.draft.points else s.track
     if track is not None:
         s.client.send_file_download(f"{track.name or 'track'}.svg", track.to_svg().encode())
 
@@ -161,10 +136,75 @@ def _add_obstacle(s, kind: str) -> None:
     else:
         ob = {"type": "box", "center": [x, y], "size": [round(2 * size, 3), round(size, 3)],
               "angle_deg": round(math.degrees(heading), 1)}
-    vx, vy = s.ui.velocity.value
-    if vx or vy:
-        ob["motion"] = {"velocity": [vx, vy]}
-    s.apply_scenario(dict(s.scenario, obstacles=[*s.scenario["obstacles"], ob]))
+    add_obstacle(s, ob)
+
+
+def _close_polygon(s) -> None:
+    """The clicked corners become a polygon obstacle."""
+    if len(s.polygon) < 3:
+        s.notify("No polygon", "tick 'Polygon (click the ground)' and click 3 or more corners")
+        return
+    ob = {"type": "polygon", "points": [[round(x, 5), round(y, 5)] for x, y in s.polygon]}
+    s.polygon = []
+    show_polygon(s)
+    s.ui.polygon.value = False
+    add_obstacle(s, ob)
+
+
+def add_obstacle(s, ob: dict) -> None:
+    """Add ``ob`` with the motion chosen in the panel; it becomes the selected obstacle."""
+    try:
+        motion = _motion(s, ob)
+    except ValueError as exc:
+        s.notify("Obstacle not added", str(exc))
+        return
+    if motion is not None:
+        ob = dict(ob, motion=motion)
+    if s.apply_scenario(dict(s.scenario, obstacles=[*s.scenario["obstacles"], ob])):
+        s.selected = len(s.scenario["obstacles"]) - 1
+
+
+def _set_motion(s) -> None:
+    """The panel's motion for the selected obstacle (the last one added or dragged)."""
+    obstacles = list(s.scenario["obstacles"])
+    if s.selected is None or s.selected >= len(obstacles):
+        s.notify("No obstacle selected", "add an obstacle or drag one first")
+        return
+    try:
+        motion = _motion(s, obstacles[s.selected])
+    except ValueError as exc:
+        s.notify("Motion not set", str(exc))
+        return
+    ob = {k: v for k, v in obstacles[s.selected].items() if k != "motion"}
+    obstacles[s.selected] = ob if motion is None else dict(ob, motion=motion)
+    s.apply_scenario(dict(s.scenario, obstacles=obstacles))
+
+
+def _motion(s, ob: dict) -> dict | None:
+    """The `Motion` control as a scenario motion (planner/scenario.py Motion) for ``ob``."""
+    kind = s.ui.motion.value
+    if kind == "velocity":
+        return {"velocity": [float(v) for v in s.ui.velocity.value]}
+    if kind == "waypoints":
+        return {"waypoints": parse_waypoints(s.ui.waypoints.value)}
+    if kind == "follow track":
+        x, y = np.mean(np.reshape(ob.get("center", ob.get("points")), (-1, 2)), axis=0)
+        return {"follow_track": {"speed": float(s.ui.track_speed.value),
+                                 "start_s": round(nearest_s(s.track, x, y), 4)}}
+    return None
+
+
+def parse_waypoints(text: str) -> list[list[float]]:
+    """'0 0 0; 3 0.5 0' → [[0, 0, 0], [3, 0.5, 0]]: rows t (s), dx, dy (m) from where the
+    obstacle is drawn."""
+    rows = [r for r in re.split(r"[;\n]", text) if r.strip()]
+    try:
+        out = [[float(v) for v in re.split(r"[\s,]+", r.strip())] for r in rows]
+    except ValueError:
+        out = []
+    if not out or any(len(r) != 3 for r in out):
+        raise ValueError(f"waypoints are rows 't dx dy' separated by ';', got {text!r}")
+    return out
 
 
 # -- scenarios --------------------------------------------------------------------------------
@@ -177,16 +217,17 @@ def _scenario_uploaded(s) -> None:
 
 
 def load_scenario(s, data: dict) -> None:
-    """A library-track scenario keeps its track; any other is drawn by its bounds."""
+    """A scenario with a track (library or embedded) shows it; any other is drawn by its
+    bounds."""
     scenario = planner.parse_scenario(data)  # raises ScenarioError with a one-line message
     if scenario.track is not None:
-        s.set_track(tracks.load_library_track(scenario.track.name), data, [])
+        s.set_track(resolve_track(scenario), data)
         return
     xmin, ymin, xmax, ymax = scenario.bounds
     box = [[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax], [xmin, ymin]]
     track = tracks.Track(name=scenario.name, closed=False, width_m=1e-3, segments=tuple(
         tracks.line(np.array(a), np.array(b)) for a, b in itertools.pairwise(box)))
-    s.set_track(track, data, [])
+    s.set_track(track, data)
 
 
 def _save_to_server(s) -> None:
@@ -212,25 +253,3 @@ def _load_from_server(s) -> None:
         load_scenario(s, found[-1]["scenario"])
     except (httpx.HTTPError, KeyError, ValueError) as exc:
         s.notify("Not loaded", f"scenario '{name}' from the server: {exc}")
-
-
-# -- the car ----------------------------------------------------------------------------------
-def _start_drive(s) -> None:
-    import time
-
-    s._drive_t0 = time.monotonic()
-
-
-def drive_step(s, elapsed: float) -> None:
-    """Put the car footprint where the best path is ``elapsed`` seconds after the start."""
-    path = s.worker.live.best_path
-    t = elapsed % max(path[-1, 5], 1e-3)
-    k = int(np.searchsorted(path[:, 5], t).clip(0, len(path) - 1))
-    x, y, th = path[k, :3]
-    size = s.marker() * 4
-    c, si = math.cos(th), math.sin(th)
-    local = np.array([[-0.3, -0.25], [0.7, -0.25], [0.7, 0.25], [-0.3, 0.25]]) * size
-    ring = np.column_stack([x + c * local[:, 0] - si * local[:, 1],
-                            y + si * local[:, 0] + c * local[:, 1]])
-    s.scene.add_line_segments("/live/car", polyline_segments(ring, Z["pose"], closed=True),
-                              (20, 20, 20), thickness=3.0, thickness_units="screen")

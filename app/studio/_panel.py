@@ -7,10 +7,11 @@ from dataclasses import dataclass
 import tracks
 from app.studio._extend import render
 
-__all__ = ["ALGORITHMS", "SPEEDS", "STEERINGS", "Panel", "build_panel"]
+__all__ = ["ALGORITHMS", "MOTIONS", "SPEEDS", "STEERINGS", "Panel", "build_panel"]
 
 ALGORITHMS = {"RRT*": "rrtstar", "RRT": "rrt"}
 STEERINGS = {"Dubins": "dubins", "Reeds-Shepp": "reeds-shepp"}
+MOTIONS = ("static", "velocity", "waypoints", "follow track")
 SPEEDS = {"max": None, "2000 it/s": 2000.0, "200 it/s": 200.0, "20 it/s": 20.0}
 
 
@@ -30,8 +31,15 @@ class Panel:
     draw_download: object
     add_circle: object
     add_box: object
+    polygon: object
+    close_polygon: object
     clear_obstacles: object
+    handles: object
+    motion: object
     velocity: object
+    waypoints: object
+    track_speed: object
+    set_motion: object
     scene_time: object
     play: object
     scenario_download: object
@@ -76,8 +84,15 @@ def build_panel(gui) -> Panel:
     with gui.add_folder("Obstacles"):
         add_circle = gui.add_button("Add circle")
         add_box = gui.add_button("Add box")
+        polygon = gui.add_checkbox("Polygon (click the ground)", False)
+        close_polygon = gui.add_button("Close polygon")
         clear_obstacles = gui.add_button("Clear obstacles")
-        velocity = gui.add_vector2("Velocity of new (m/s)", (0.0, 0.0), step=0.05)
+        handles = gui.add_checkbox("Drag handles", True)
+        motion = gui.add_dropdown("Motion", tuple(MOTIONS), initial_value="static")
+        velocity = gui.add_vector2("Velocity (m/s)", (0.3, 0.0), step=0.05)
+        waypoints = gui.add_text("Waypoints (t dx dy; …)", "0 0 0; 3 0.5 0; 6 0.5 0.5")
+        track_speed = gui.add_number("Speed along track (m/s)", 0.5, step=0.1)
+        set_motion = gui.add_button("Set motion of selected")
         scene_time = gui.add_slider("Scene time (s)", 0.0, 30.0, 0.1, 0.0)
         play = gui.add_checkbox("Play scene time", False)
     with gui.add_folder("Scenario", expand_by_default=False):

@@ -12,9 +12,12 @@ import numpy as np
 import shapely
 
 import planner
+from planner.problem import follow_waypoints
 
-__all__ = ["Z", "curvature_colors", "draw_obstacles", "draw_poses", "draw_track", "fit_camera",
-           "obstacle_rings", "polyline_segments"]
+__all__ = ["Z", "add_grid", "car_outline", "curvature_colors", "draw_obstacles", "draw_poses",
+           "draw_track", "fit_camera", "motion_table", "move_obstacles", "obstacle_rings",
+           "obstacle_shape",
+           "offset_at", "polyline_segments", "wxyz_yaw", "yaw_wxyz"]
 
 Z = {"surface": -0.02, "centre": 0.002, "obstacle": 0.004, "tree": 0.006, "flash": 0.008,
      "path": 0.01, "step": 0.012, "pose": 0.014}
@@ -78,63 +81,117 @@ def draw_track(scene, track, kappa_max: float) -> None:
                             thickness_units="screen")
 
 
-def obstacle_rings(scenario: planner.Scenario, t: float = 0.0) -> list[np.ndarray]:
-    """Each obstacle's outline at time t (circles as 48-gons), motions applied."""
+def yaw_wxyz(yaw: float) -> tuple[float, float, float, float]:
+    """The quaternion of a rotation by ``yaw`` about +z (the ground's normal)."""
+    return (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+
+
+def wxyz_yaw(wxyz) -> float:
+    """The rotation about +z of a quaternion that only turns about z (a ground-plane gizmo)."""
+    w, _, _, z = wxyz
+    return 2.0 * math.atan2(z, w)
+
+
+def obstacle_shape(ob) -> tuple[tuple[float, float, float], np.ndarray]:
+    """An obstacle as a pose (x, y, yaw) and its outline in its own frame: dragging moves and
+    turns the pose, animation offsets it, and the outline is triangulated once."""
+    if ob.type == "circle":
+        a = np.linspace(0, 2 * math.pi, 48, endpoint=False)
+        return (*ob.center, 0.0), ob.radius * np.column_stack([np.cos(a), np.sin(a)])
+    if ob.type == "box":
+        hx, hy = ob.size[0] / 2, ob.size[1] / 2
+        return ((*ob.center, math.radians(ob.angle_deg)),
+                np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]]))
+    pts = np.array(ob.points, dtype=float)
+    c = np.asarray(shapely.Polygon(pts).centroid.coords[0])
+    return (*c, 0.0), pts - c
+
+
+def obstacle_rings(scenario: planner.Scenario, t: float = 0.0, track=None) -> list[np.ndarray]:
+    """Each obstacle's outline in world coordinates at time t (``track``: for obstacles that
+    follow it)."""
     out = []
     for ob in scenario.obstacles:
-        if ob.type == "circle":
-            a = np.linspace(0, 2 * math.pi, 48, endpoint=False)
-            ring = np.column_stack([ob.center[0] + ob.radius * np.cos(a),
-                                    ob.center[1] + ob.radius * np.sin(a)])
-        elif ob.type == "box":
-            ring = np.array(ob.corners())
-        else:
-            ring = np.array(ob.points, dtype=float)
-        out.append(ring + _offset(ob.motion, t))
+        (x, y, yaw), local = obstacle_shape(ob)
+        c, s = math.cos(yaw), math.sin(yaw)
+        out.append(local @ np.array([[c, s], [-s, c]]) + [x, y]
+                   + offset_at(motion_table(ob.motion, track), t))
     return out
 
 
-def _offset(motion, t: float) -> np.ndarray:
+def motion_table(motion, track) -> np.ndarray | None:
+    """A motion as rows (t, dx, dy) whose linear interpolation (clamped) is the obstacle's
+    offset at time t, as the planner reads it; None for a static obstacle."""
     if motion is None:
-        return np.zeros(2)
+        return None
     if motion.velocity is not None:
-        return np.array(motion.velocity) * t
+        horizon = 1e4
+        return np.array([[0.0, 0.0, 0.0], [horizon, *(np.array(motion.velocity) * horizon)]])
     if motion.waypoints is not None:
-        w = np.array(motion.waypoints)
-        return np.array([np.interp(t, w[:, 0], w[:, 1]), np.interp(t, w[:, 0], w[:, 2])])
-    return np.zeros(2)  # follow_track: drawn where it starts
+        return np.array(motion.waypoints, dtype=float)
+    return follow_waypoints(track, motion.follow_track)
 
 
-def draw_obstacles(scene, scenario: planner.Scenario, t: float = 0.0) -> list:
-    """Static obstacles red, moving ones orange (where they are at time t); returns handles."""
-    handles = []
-    for i, ring in enumerate(obstacle_rings(scenario, t)):
-        moving = scenario.obstacles[i].motion is not None
-        handles.append(_fill(scene, f"/obstacles/o{i}", [ring], Z["obstacle"],
-                             (230, 140, 40) if moving else (200, 60, 60)))
-    return handles
+def offset_at(table: np.ndarray | None, t: float) -> np.ndarray:
+    if table is None:
+        return np.zeros(2)
+    return np.array([np.interp(t, table[:, 0], table[:, 1]),
+                     np.interp(t, table[:, 0], table[:, 2])])
 
 
-def _car_outline(pose, length: float, width: float) -> np.ndarray:
-    x, y, th = pose
-    c, s = math.cos(th), math.sin(th)
-    local = np.array([[-0.3, -0.5], [0.7, -0.5], [1.0, 0.0], [0.7, 0.5], [-0.3, 0.5]])
-    local = local * [length, width]
-    return np.column_stack([x + c * local[:, 0] - s * local[:, 1],
-                            y + s * local[:, 0] + c * local[:, 1]])
+def draw_obstacles(scene, scenario: planner.Scenario, track) -> list[tuple]:
+    """Static obstacles red, moving ones orange, each a frame ``/obstacles/o{i}`` at its pose
+    holding its outline; returns (frame, pose, motion table) per obstacle for `move_obstacles`."""
+    out = []
+    for i, ob in enumerate(scenario.obstacles):
+        pose, local = obstacle_shape(ob)
+        frame = scene.add_frame(f"/obstacles/o{i}", show_axes=False, position=(*pose[:2], 0.0),
+                                wxyz=yaw_wxyz(pose[2]))
+        _fill(scene, f"/obstacles/o{i}/shape", [local], Z["obstacle"],
+              (230, 140, 40) if ob.motion is not None else (200, 60, 60))
+        out.append((frame, pose, motion_table(ob.motion, track)))
+    return out
 
 
-def draw_poses(scene, scenario: planner.Scenario, size: float) -> None:
-    """Start (green) and goal (gold) as arrow-nosed car footprints; the goal's tolerance disc."""
-    _fill(scene, "/poses/start", [_car_outline(scenario.start, size, 0.5 * size)], Z["pose"],
-          (60, 200, 90))
-    _fill(scene, "/poses/goal", [_car_outline(scenario.goal, size, 0.5 * size)], Z["pose"],
-          (250, 200, 40))
+def move_obstacles(drawn: list[tuple], t: float) -> None:
+    """Put each moving obstacle where it is at scene time t (a position update, no mesh)."""
+    for frame, pose, table in drawn:
+        if table is not None:
+            frame.position = (*(np.array(pose[:2]) + offset_at(table, t)), 0.0)
+
+
+def car_outline(length: float, width: float) -> np.ndarray:
+    """An arrow-nosed car footprint in its own frame (rear axle at the origin, heading +x)."""
+    return np.array([[-0.3, -0.5], [0.7, -0.5], [1.0, 0.0], [0.7, 0.5], [-0.3, 0.5]]) * [
+        length, width]
+
+
+def draw_poses(scene, scenario: planner.Scenario, size: float) -> dict:
+    """Start (green) and goal (gold) as car footprints in frames ``/poses/start`` and
+    ``/poses/goal`` (dragging moves the frame); the goal's tolerance disc. Returns the frames."""
+    frames = {}
+    for name, pose, rgb in (("start", scenario.start, (60, 200, 90)),
+                            ("goal", scenario.goal, (250, 200, 40))):
+        frames[name] = scene.add_frame(f"/poses/{name}", show_axes=False, position=(*pose[:2], 0.0),
+                        wxyz=yaw_wxyz(pose[2]))
+        _fill(scene, f"/poses/{name}/shape", [car_outline(size, 0.5 * size)], Z["pose"], rgb)
     a = np.linspace(0, 2 * math.pi, 48, endpoint=False)
-    r = scenario.goal_tolerance.position
-    ring = np.column_stack([scenario.goal[0] + r * np.cos(a), scenario.goal[1] + r * np.sin(a)])
-    scene.add_line_segments("/poses/goal_tol", polyline_segments(ring, Z["pose"], closed=True),
+    ring = scenario.goal_tolerance.position * np.column_stack([np.cos(a), np.sin(a)])
+    scene.add_line_segments("/poses/goal/tol", polyline_segments(ring, Z["pose"], closed=True),
                             (250, 200, 40), thickness=1.5, thickness_units="screen")
+    return frames
+
+
+def add_grid(scene, bounds) -> None:
+    """A ground grid scaled to the scene: cells of a power of ten near a tenth of its size, so
+    a 30 cm track drawn in mm gets centimetre cells and a 100 m one ten-metre cells."""
+    xmin, ymin, xmax, ymax = bounds
+    extent = max(xmax - xmin, ymax - ymin)
+    cell = 10.0 ** math.floor(math.log10(extent / 4))
+    size = 20 * cell * math.ceil(extent / cell)
+    scene.add_grid("/grid", size, size, plane="xy", cell_size=cell, section_size=5 * cell,
+                   position=((xmin + xmax) / 2, (ymin + ymax) / 2, Z["surface"] - 0.01 * cell),
+                   cell_color=(225, 225, 225), section_color=(190, 190, 190))
 
 
 def fit_camera(client, bounds, fov_deg: float = 20.0, usable: float = 0.72) -> None:

@@ -18,16 +18,24 @@ import numpy as np
 import planner
 import tracks
 from app.studio import _actions
+from app.studio._custom import Draft
+from app.studio._edit import place_gizmos
 from app.studio._extend import explain, render
 from app.studio._live_view import LiveView
 from app.studio._panel import ALGORITHMS, SPEEDS, STEERINGS, build_panel
 from app.studio._plots import Profiles
 from app.studio._scenario import default_scenario, goal_fraction
 from app.studio._scene import (
+    Z,
+    add_grid,
+    car_outline,
     draw_obstacles,
     draw_poses,
     draw_track,
     fit_camera,
+    move_obstacles,
+    polyline_segments,
+    yaw_wxyz,
 )
 from app.studio._worker import PlannerWorker
 
@@ -44,15 +52,23 @@ class Session:
         self.client, self.scene, self.api_url = client, client.scene, api_url
         self.ui = build_panel(client.gui)
         self.track: tracks.Track | None = None
-        self.region: list[dict] = []  # a custom track's outside, as polygons
         self.scenario: dict = {}
+        self.parsed: planner.Scenario | None = None  # self.scenario, validated
         self.problem = None
         self.worker: PlannerWorker | None = None
         self.view: LiveView | None = None
         self.profiles: Profiles | None = None
-        self.draft: list[tuple[float, float]] = []  # points of a track being drawn
-        self._obstacle_handles: list = []
-        self._drive_t0: float | None = None
+        self.draft = Draft()  # a track being drawn
+        self.draft_gizmos: list = []
+        self.polygon: list[tuple[float, float]] = []  # corners of a polygon being clicked
+        self.click_mode: str | None = None
+        self.drawn: list[tuple] = []  # (frame, pose, motion table) per obstacle
+        self.pose_frames: dict = {}
+        self.gizmos: list = []
+        self.selected: int | None = None  # the obstacle `Set motion of selected` changes
+        self.driving = False  # the car footprint shows the best path at scene time
+        self._car = None
+        self._played_at = time.monotonic()
         self._lock = threading.RLock()
         self._closed = False
         _actions.wire(self)
@@ -63,20 +79,18 @@ class Session:
 
     # -- scenario ------------------------------------------------------------------------------
     def load_library(self, name: str) -> None:
-        self.set_track(tracks.load_library_track(name), default_scenario(name), [])
+        self.set_track(tracks.load_library_track(name), default_scenario(name))
 
-    def set_track(self, track: tracks.Track, scenario: dict, region: list[dict]) -> None:
+    def set_track(self, track: tracks.Track, scenario: dict) -> None:
         """Show a new track with its scenario; redraws everything and resets the planner."""
         with self._lock:
-            self.track, self.region = track, region
+            self.track = track
             vehicle = planner.parse_scenario(scenario).vehicle
             self.scene.reset()
             self.scene.set_up_direction("+z")
-            self.scene.add_grid("/grid", 200, 200, plane="xy", cell_size=1.0, section_size=5.0,
-                                position=(0, 0, -0.03), cell_color=(225, 225, 225),
-                                section_color=(190, 190, 190))
+            add_grid(self.scene, track.bbox())
             draw_track(self.scene, track, 1.0 / vehicle.turning_radius)
-            self._obstacle_handles = []
+            self.drawn, self.gizmos, self.draft_gizmos, self._car = [], [], [], None
             self.view = None
             self._make_profiles(track, vehicle)
             self.apply_scenario(scenario)
@@ -93,37 +107,77 @@ class Session:
                                      vehicle.wheelbase, vehicle.max_steer_deg)
 
     def apply_scenario(self, scenario: dict) -> bool:
-        """Compile and show ``scenario`` (start, goal, obstacles); keeps the old one on error."""
-        full = dict(scenario, obstacles=[*scenario.get("obstacles", []), *self.region])
+        """Compile and show ``scenario`` (start, goal, obstacles); keeps the old one on error.
+        Any change to the scenario resets the planner: its tree belongs to the old one."""
         try:
-            problem = planner.compile_problem(planner.parse_scenario(full))
+            parsed = planner.parse_scenario(scenario)
+            problem = planner.compile_problem(parsed)
         except (planner.ScenarioError, ValueError) as exc:
             self.notify("Scenario not changed", str(exc))
+            with self._lock:
+                if self.parsed is not None:
+                    self.draw_scenario()  # puts a dragged gizmo back
             return False
         with self._lock:
-            self.scenario, self.problem = copy.deepcopy(scenario), problem
-            self.draw_scenario(self.ui.scene_time.value)
+            self.scenario, self.parsed, self.problem = copy.deepcopy(scenario), parsed, problem
+            self.draw_scenario()
             self.reset()
         return True
 
-    def draw_scenario(self, t: float = 0.0) -> None:
-        """Obstacles (where they are at scene time t), start and goal."""
-        for h in self._obstacle_handles:
-            if h is not None:
-                h.remove()
-        user = planner.parse_scenario(dict(self.scenario, obstacles=self.scenario["obstacles"]))
-        self._obstacle_handles = draw_obstacles(self.scene, user, t)
-        draw_poses(self.scene, user, self.marker() * 4)
+    def draw_scenario(self) -> None:
+        """Obstacles (where they are at the scene time), start, goal and their gizmos."""
+        for frame, _, _ in self.drawn:
+            frame.remove()
+        self.drawn = draw_obstacles(self.scene, self.parsed, self.track)
+        move_obstacles(self.drawn, self.ui.scene_time.value)
+        self.pose_frames = draw_poses(self.scene, self.parsed, self.marker() * 4)
+        place_gizmos(self)
+
+    def add_obstacle(self, ob: dict) -> None:
+        _actions.add_obstacle(self, ob)
+
+    def show_time(self, t: float) -> None:
+        """The scene clock: moving obstacles and the driving car, both at time t."""
+        with self._lock:
+            move_obstacles(self.drawn, t)
+            path = self.worker.live.best_path if self.worker is not None else None
+            if self.driving and path is not None and len(path):
+                self._show_car(path, t)
+
+    def _show_car(self, path: np.ndarray, t: float) -> None:
+        """The car footprint where the best path is at time t (its column 5)."""
+        k = int(np.searchsorted(path[:, 5], t).clip(0, len(path) - 1))
+        x, y, th = path[k, :3]
+        if self._car is None:
+            size = self.marker() * 4
+            ring = car_outline(size, 0.5 * size)
+            self._car = self.scene.add_line_segments(
+                "/live/car", polyline_segments(ring, Z["pose"], closed=True), (20, 20, 20),
+                thickness=3.0, thickness_units="screen")
+        self._car.position = (float(x), float(y), 0.0)
+        self._car.wxyz = yaw_wxyz(float(th))
+
+    def drive(self) -> None:
+        """`Drive car`: the scene clock restarts at 0 and plays; the car and the moving
+        obstacles share it, so what the planner avoided in time is what you see avoided."""
+        path = self.worker.live.best_path
+        if path is None or not len(path):
+            self.notify("No path yet", "press Run until a path to the goal is found")
+            return
+        self.driving = True
+        self.ui.scene_time.max = max(self.ui.scene_time.max, math.ceil(path[-1, 5]))
+        self.ui.scene_time.value = 0.0
+        self.ui.play.value = True
+        self.show_time(0.0)
 
     def marker(self) -> float:
         xmin, ymin, xmax, ymax = self.problem.bounds if self.problem else (0, 0, 10, 10)
         return 0.006 * max(xmax - xmin, ymax - ymin)
 
     def scenario_json(self) -> str:
-        """The scenario as the user sees it; a custom track's region goes in as obstacles."""
-        out = dict(self.scenario, name=self.ui.scenario_name.value or "studio")
-        out["obstacles"] = [*self.scenario["obstacles"], *self.region]
-        return json.dumps(out, indent=2)
+        """The scenario as planned (a custom track embedded), named by the `Name` field."""
+        return json.dumps(dict(self.scenario, name=self.ui.scenario_name.value or "studio"),
+                          indent=2)
 
     # -- planner -------------------------------------------------------------------------------
     def settings(self) -> planner.PlannerSettings:
@@ -150,7 +204,10 @@ class Session:
                                         SPEEDS[self.ui.rate.value])
             self.view = LiveView(self.scene, self.worker.live, self.marker())
             self._shown = {"metrics": -1, "best": 0, "step": 0, "costs": 0}
-            self._drive_t0 = None
+            self.driving = False
+            if self._car is not None:
+                self._car.remove()
+                self._car = None
             self.ui.metrics.content = "—"
             self.ui.extend.content = render(None, "Press Step to run one iteration.")
             if self.profiles is not None:
@@ -166,8 +223,8 @@ class Session:
 
     # -- the ticker ----------------------------------------------------------------------------
     def _tick_loop(self) -> None:
+        due = time.perf_counter()
         while not self._closed:
-            t0 = time.perf_counter()
             try:
                 with self._lock:
                     self.tick()
@@ -175,7 +232,10 @@ class Session:
                 if self._closed:
                     return
                 print(f"studio: tick failed: {type(exc).__name__}: {exc}")
-            time.sleep(max(0.0, TICK_S - (time.perf_counter() - t0)))
+            # A fixed schedule: a late tick (the planner's thread held the GIL) shortens the next
+            # wait instead of pushing every later tick back, so the rate holds under load.
+            due = max(due + TICK_S, time.perf_counter() - TICK_S)
+            time.sleep(max(0.0, due - time.perf_counter()))
 
     def tick(self) -> None:
         w, view = self.worker, self.view
@@ -208,12 +268,16 @@ class Session:
         self._animate()
 
     def _animate(self) -> None:
-        """Scene time for moving obstacles; the car driving the best path."""
+        """Advance the scene clock while playing (setting it moves obstacles and car); a
+        driving car loops at its path's end, else the clock loops at the slider's end."""
+        now, last = time.monotonic(), self._played_at
+        self._played_at = now
         if self.ui.play.value:
-            t = self.ui.scene_time.value + TICK_S
-            self.ui.scene_time.value = 0.0 if t > self.ui.scene_time.max else t
-        if self._drive_t0 is not None and self.worker.live.best_path is not None:
-            _actions.drive_step(self, time.monotonic() - self._drive_t0)
+            path = self.worker.live.best_path
+            end = (path[-1, 5] if self.driving and path is not None and len(path)
+                   else self.ui.scene_time.max)
+            t = self.ui.scene_time.value + min(now - last, 4 * TICK_S)  # real time, no jumps
+            self.ui.scene_time.value = 0.0 if t > end else t
 
     def close(self) -> None:
         self._closed = True
