@@ -5,7 +5,8 @@ boundaries), static obstacles and movers where their motion puts them at t — n
 planner's belief. All sensors sit at the car's reference point (the rear-axle centre, which is
 also the centre of its collision disc), so a reading is the distance from there along the ray.
 
-- wall sensors (``left`` / ``right``): one ray perpendicular to the heading, for wall following;
+- wall sensors (``left`` / ``right``): a ray perpendicular to the heading and one 30° ahead of
+  it, giving the wall's distance and the car's angle to it, for wall following;
 - ultrasonic sensors ``left`` / ``front`` / ``right``: a narrow cone (a fan of rays, the shortest
   echo wins) pointing left, ahead and right;
 - the lane ahead: parallel rays ahead across the car's width, for ``ObstacleAhead``.
@@ -25,13 +26,14 @@ from planner._world import World
 from planner.sim.sensing import true_offsets
 
 __all__ = ["MAX_RANGE", "Scene", "cast", "lane_ahead", "scene_at", "scene_of", "ultrasonic",
-           "wall_range"]
+           "wall_estimate", "wall_range"]
 
 MAX_RANGE = 4.0  # m, an ultrasonic sensor's reach
 CONE_HALF = math.radians(15.0)  # half opening angle of an ultrasonic cone
 CONE_RAYS = 7
 LANE_RAYS = 5
 LANE_MARGIN = 0.1  # m beyond the car's widest disc on either side
+WALL_AHEAD = math.radians(30.0)  # the wall sensor's second ray, from the perpendicular
 DIRECTIONS = {"left": 0.5 * math.pi, "front": 0.0, "right": -0.5 * math.pi}
 
 
@@ -99,10 +101,27 @@ def cast(segments: np.ndarray, circles: np.ndarray, ox, oy, angles,
     return np.where(best <= max_range, best, np.inf)
 
 
-def wall_range(segments, circles, pose, side: str, max_range: float = MAX_RANGE) -> float:
-    """The perpendicular ray to ``side`` (left | right): distance to the wall there."""
+def wall_range(segments, circles, pose, side: str, ahead: float = 0.0,
+               max_range: float = MAX_RANGE) -> float:
+    """The ray to ``side`` (left | right), turned ``ahead`` radians towards the front from the
+    perpendicular: distance to the wall there."""
     x, y, th = pose
-    return float(cast(segments, circles, x, y, [th + DIRECTIONS[side]], max_range)[0])
+    turn = -ahead if side == "left" else ahead
+    return float(cast(segments, circles, x, y, [th + DIRECTIONS[side] + turn], max_range)[0])
+
+
+def wall_estimate(segments, circles, pose, side: str) -> tuple[float, float]:
+    """(distance, angle) of a straight wall on ``side`` from the perpendicular ray b and one
+    ``WALL_AHEAD`` further forward, a: the car heads towards the wall at ψ = atan((b − a·cos φ) /
+    (a·sin φ)) and is b·cos ψ from it. The perpendicular reading alone, d / cos ψ, grows as the
+    car turns either way, which would feed a PD turning towards the wall. Without an echo
+    ahead (the wall ends) ψ reads 0; without a perpendicular one, the distance is inf."""
+    b = wall_range(segments, circles, pose, side)
+    a = wall_range(segments, circles, pose, side, WALL_AHEAD)
+    if not math.isfinite(b) or not math.isfinite(a):
+        return b, 0.0
+    psi = math.atan2(b - a * math.cos(WALL_AHEAD), a * math.sin(WALL_AHEAD))
+    return b * math.cos(psi), psi
 
 
 def ultrasonic(segments, circles, pose, name: str, max_range: float = MAX_RANGE) -> float:

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from planner._world import World
 from planner.sim.fsm.spec import Machine, State
 from planner.sim.rangefinder import (LANE_MARGIN, lane_ahead, scene_at, scene_of, ultrasonic,
-                                     wall_range)
+                                     wall_estimate)
 
 __all__ = ["Behaviour"]
 
@@ -51,8 +51,8 @@ class Sensors:
             self._cache[key] = fn(*self._targets(), self.pose, *args)
         return self._cache[key]
 
-    def wall(self, side: str) -> float:
-        return self._read(("wall", side), wall_range, side)
+    def wall(self, side: str) -> tuple[float, float]:
+        return self._read(("wall", side), wall_estimate, side)
 
     def ultrasonic(self, name: str) -> float:
         return self._read(("us", name), ultrasonic, name)
@@ -117,24 +117,25 @@ class FollowTrack(Idle):
 
 
 class FollowWall(Idle):
-    """PD on the perpendicular wall range: δ = ±(kp·e + kd·ė), e = range − clearance (m), turning
-    towards the wall when too far. Where the wall opens (a junction) it drives straight."""
-
-    def enter(self, tick: Tick) -> None:
-        self.e_old = None
+    """PD on the wall sensor: δ = ±(kp·e + kd·ė), e = distance − clearance (m), turning towards
+    the wall when too far. ė = −speed·(sin ψ + clearance rate), with ψ the car's angle towards
+    the wall: the error's rate at the state's speed, so the path converges the same way while
+    the car speeds up. Where the wall opens (a junction) it drives straight."""
 
     def clearance(self) -> float:
         return self.p["distance_m"]
 
+    def clearance_rate(self) -> float:
+        """d(clearance)/d(metres driven)."""
+        return 0.0
+
     def tick(self, tick: Tick) -> tuple[float, float]:
         want = self.clearance()
-        r = tick.sensors.wall(self.p["side"])
-        if r > want + WALL_LOST_M:
-            self.e_old = None
+        dist, psi = tick.sensors.wall(self.p["side"])
+        if dist > want + WALL_LOST_M:
             return self.p["speed"], 0.0
-        e = r - want
-        de = 0.0 if self.e_old is None else (e - self.e_old) / tick.dt
-        self.e_old = e
+        e = dist - want
+        de = -self.p["speed"] * (math.sin(psi) + self.clearance_rate())
         towards = 1.0 if self.p["side"] == "left" else -1.0
         return self.p["speed"], towards * (self.p["kp"] * e + self.p["kd"] * de)
 
@@ -146,6 +147,11 @@ class FollowWallRamp(FollowWall):
     def clearance(self) -> float:
         f = min(self.driven / self.p["over_m"], 1.0)
         return self.p["from_m"] + f * (self.p["to_m"] - self.p["from_m"])
+
+    def clearance_rate(self) -> float:
+        if self.driven >= self.p["over_m"]:
+            return 0.0
+        return (self.p["to_m"] - self.p["from_m"]) / self.p["over_m"]
 
     def finished(self, tick: Tick) -> bool:
         return self.driven >= self.p["over_m"]
