@@ -1,4 +1,5 @@
-"""Behaviour state machines (issue 9): the JSON format and its checks; the runtime is to come."""
+"""Behaviour state machines (issue 9): the JSON format and its checks (`spec`); the runtime that
+drives the simulated car is `runtime.Behaviour`, used by `planner.sim.simulate(behaviour=...)`."""
 
 from planner.sim.fsm.spec import FsmError, Machine, State, Transition, load_fsm, parse_fsm
 
