@@ -22,8 +22,15 @@ import planner
 from planner._world import build_world
 from planner.sim import SimSettings, simulate
 from planner.sim.fsm import parse_fsm
-from planner.sim.rangefinder import (cast, lane_ahead, scene_at, scene_of, ultrasonic,
-                                     wall_estimate, wall_range)
+from planner.sim.rangefinder import (
+    cast,
+    lane_ahead,
+    scene_at,
+    scene_of,
+    ultrasonic,
+    wall_estimate,
+    wall_range,
+)
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "fsm" / "hallway.json"
 DT = 0.01
@@ -304,8 +311,8 @@ def test_cli_drives_by_the_machine_and_logs_the_state(tmp_path):
 @pytest.mark.parametrize("content, needle", [
     ("{not json", "not JSON"),
     (None, "No such file"),
-    ('{"initial": "a", "states": [{"id": "a", "type": "FollowWall", '
-     '"params": {"side": "up", "distance_m": 1, "speed": 1}}]}', "states[0].params.side"),
+    (('{"initial": "a", "states": [{"id": "a", "type": "FollowWall", '
+      '"params": {"side": "up", "distance_m": 1, "speed": 1}}]}'), "states[0].params.side"),
 ])
 def test_cli_rejects_a_bad_machine_in_one_line(tmp_path, content, needle):
     path = tmp_path / "fsm.json"

@@ -13,13 +13,14 @@ from __future__ import annotations
 
 import json
 import sys
+from pathlib import Path
 
 import matplotlib
 import numpy as np
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.patches import Circle, Polygon, Rectangle  # noqa: E402
+import matplotlib.pyplot as plt
+from matplotlib.patches import Circle, Polygon, Rectangle
 
 
 def _approach_points(ax, machine: dict, prefix: str = "") -> None:
@@ -34,10 +35,9 @@ def _approach_points(ax, machine: dict, prefix: str = "") -> None:
 
 
 def main(scenario_path, fsm_path, log_path, summary_path, out) -> None:
-    scn = json.load(open(scenario_path))
-    machine = json.load(open(fsm_path))
+    scn, machine, s = (json.loads(Path(p).read_text())
+                       for p in (scenario_path, fsm_path, summary_path))
     log = np.genfromtxt(log_path, delimiter=",", names=True)
-    s = json.load(open(summary_path))
     fig, ax = plt.subplots(figsize=(11, 8.6))
     x0, y0, x1, y1 = scn["bounds"]
     ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, lw=1.5))
@@ -55,7 +55,7 @@ def main(scenario_path, fsm_path, log_path, summary_path, out) -> None:
     _approach_points(ax, machine)
     dt = log["t"][1] - log["t"][0]
     for tr in s["behaviour"]["transitions"]:
-        k = int(round(tr["t"] / dt))
+        k = round(tr["t"] / dt)
         ax.plot(log["x"][k], log["y"][k], "k|", ms=8)
     gx, gy, _ = scn["goal"]
     tol = scn.get("goal_tolerance", {}).get("position", 0.1)

@@ -31,7 +31,7 @@ __all__ = ["MAX_RANGE", "Scene", "cast", "lane_ahead", "scene_at", "scene_of", "
 MAX_RANGE = 4.0  # m, an ultrasonic sensor's reach
 CONE_HALF = math.radians(15.0)  # half opening angle of an ultrasonic cone
 CONE_RAYS = 7
-LANE_RAYS = 5
+LANE_SPACING = 0.05  # m at most between the lane's parallel rays: a 5 cm post cannot slip through
 LANE_MARGIN = 0.1  # m beyond the car's widest disc on either side
 WALL_AHEAD = math.radians(30.0)  # the wall sensor's second ray, from the perpendicular
 DIRECTIONS = {"left": 0.5 * math.pi, "front": 0.0, "right": -0.5 * math.pi}
@@ -135,6 +135,7 @@ def lane_ahead(segments, circles, pose, half_width: float,
                max_range: float = MAX_RANGE) -> float:
     """Free distance ahead in the car's lane: parallel rays across ±``half_width``."""
     x, y, th = pose
-    lateral = np.linspace(-half_width, half_width, LANE_RAYS)
+    n = math.ceil(2.0 * half_width / LANE_SPACING - 1e-9) + 1
+    lateral = np.linspace(-half_width, half_width, n)
     ox, oy = x - lateral * math.sin(th), y + lateral * math.cos(th)
     return float(cast(segments, circles, ox, oy, th, max_range).min())

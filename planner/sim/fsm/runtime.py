@@ -20,8 +20,14 @@ from dataclasses import dataclass
 
 from planner._world import World
 from planner.sim.fsm.spec import Machine, State
-from planner.sim.rangefinder import (LANE_MARGIN, lane_ahead, scene_at, scene_of, ultrasonic,
-                                     wall_estimate)
+from planner.sim.rangefinder import (
+    LANE_MARGIN,
+    lane_ahead,
+    scene_at,
+    scene_of,
+    ultrasonic,
+    wall_estimate,
+)
 
 __all__ = ["Behaviour"]
 
@@ -244,8 +250,8 @@ class _Run:
                 self.state.exit(tick)
                 before = self.state.path
                 self._enter(tr.to, tick)
-                self.behaviour.transitions.append(
-                    {"t": tick.t, "from": before, "to": self.state.path})
+                self.behaviour.transitions.append(  # t without k·Δt's float noise
+                    {"t": round(tick.t, 9), "from": before, "to": self.state.path})
                 return
 
     def tick(self, tick: Tick) -> tuple[float, float]:
@@ -281,19 +287,22 @@ class Behaviour:
         self.transitions: list[dict] = []
         self.trace: list[int] = []
         self.root = _Run(machine, "", self)
-        self.root.enter(self._tick(0.0, (0.0, 0.0, 0.0), 0.0, 0.0, None))
-        self.planning = isinstance(self.root.leaf(), FollowTrack)
+        self.started = False  # the initial states are entered at the first step, at t = 0
+        first = machine.states[machine.initial]
+        while first.machine is not None:
+            first = first.machine.states[first.machine.initial]
+        self.planning = first.type == "FollowTrack"
         self.planner_switched = False
-
-    def _tick(self, t, est, v, steer, planned) -> Tick:
-        return Tick(t, self.dt, est, v, steer, planned, self.sensors, self.wheelbase)
 
     def step(self, t: float, pose, est, v: float, steer: float,
              planned: tuple[float, float] | None) -> tuple[float, float]:
         """The wanted (v, δ) for the tick starting at t; ``pose`` is the true pose (sensors),
         ``v``/``steer`` the commands held over the last tick."""
         self.sensors.update(t, pose)
-        tick = self._tick(t, est, v, steer, planned)
+        tick = Tick(t, self.dt, est, v, steer, planned, self.sensors, self.wheelbase)
+        if not self.started:
+            self.root.enter(tick)
+            self.started = True
         self.root.check(tick)
         command = self.root.tick(tick)
         leaf = self.root.leaf()
