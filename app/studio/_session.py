@@ -37,6 +37,7 @@ from app.studio._scene import (
     polyline_segments,
     yaw_wxyz,
 )
+from app.studio._sim_view import SimView
 from app.studio._worker import PlannerWorker
 
 __all__ = ["Session"]
@@ -72,6 +73,7 @@ class Session:
         self._lock = threading.RLock()
         self._closed = False
         _actions.wire(self)
+        self.sim = SimView(self)
         self._unfitted_ticks = 10  # fit the view this many ticks after the browser's camera
         self.load_library("thesis")
         self._ticker = threading.Thread(target=self._tick_loop, daemon=True, name="studio-ui")
@@ -86,6 +88,7 @@ class Session:
         with self._lock:
             self.track = track
             vehicle = planner.parse_scenario(scenario).vehicle
+            self.sim.clear()
             self.scene.reset()
             self.scene.set_up_direction("+z")
             add_grid(self.scene, track.bbox())
@@ -121,6 +124,7 @@ class Session:
         with self._lock:
             self.scenario, self.parsed, self.problem = copy.deepcopy(scenario), parsed, problem
             self.draw_scenario()
+            self.sim.clear()
             self.reset()
         return True
 
@@ -249,6 +253,7 @@ class Session:
             if self._unfitted_ticks == 0:
                 self.fit()
         view.tick()
+        self.sim.tick()
         status = f"Status: **{live.state}**" + (f" — {live.error}" if live.error else "")
         if status != self.ui.status.content:  # GUI updates re-render the panel: only changes
             self.ui.status.content = status
@@ -281,6 +286,7 @@ class Session:
 
     def close(self) -> None:
         self._closed = True
+        self.sim.stop()
         if self.worker is not None:
             self.worker.stop()
 

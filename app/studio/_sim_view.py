@@ -1,0 +1,332 @@
+"""The simulated car live in one tab (issue 9): `planner.sim` played at wall-clock speed.
+
+A run goes on its own thread (`simulate(..., realtime=True)`); its observer keeps the latest
+`Frame`, the plot history and, at most every ``TREE_S``, the current tree's edges — read there,
+since a planner's arrays are only safe to read on the thread that runs it. The session's ticker
+calls `SimView.tick`, which draws the latest state: the car; the movers where they truly are
+(the session's own obstacles, its scene clock set to the simulation's time); where the car
+believes they are (translucent ghosts, extrapolated from the last sensing at
+constant velocity, with a line to where it predicts them ``PREDICT_S`` later), the committed
+path, the tree, Soll/Ist steering and lateral error plots and the metrics.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from app.studio._live_view import PATH_RGB, TREE_RGB
+from app.studio._scene import Z, _fill, obstacle_shape, polyline_segments, yaw_wxyz
+from planner._world import pose_clearance
+from planner.sim import SimSettings
+from planner.sim.control import CONTROLLERS
+from planner.sim.run import Frame, simulate
+from planner.sim.sensing import mover_index
+
+__all__ = ["SimControls", "SimView", "build_controls"]
+
+TREE_S = 0.5  # s between tree extractions (≈20 µs per edge, on the simulation's thread)
+SLOW_S = 0.5  # s between plot and metrics refreshes (uPlot redraws every point)
+PATH_S = 0.2  # s between committed-path updates (a new one arrives with every cycle)
+WINDOW_S = 20.0  # s of history in the plots
+PLOT_POINTS = 400
+PREDICT_S = 2.0  # s of predicted motion drawn ahead of each believed obstacle
+EDGE_PIECES = 4  # straight pieces per drawn tree edge
+GHOST_RGB, CAR_RGB = (90, 200, 255), (250, 250, 250)
+SIM_Z = {"ghost": Z["obstacle"] + 0.001, "car": Z["pose"] + 0.002}
+
+
+@dataclass
+class SimControls:
+    """The `Simulate` folder's handles."""
+
+    rate: object
+    controller: object
+    noise: object
+    seed: object
+    simulate: object
+    stop: object
+    status: object
+    metrics: object
+    steering: object
+    lateral: object
+
+
+def build_controls(gui) -> SimControls:
+    with gui.add_folder("Simulate"):
+        rate = gui.add_number("Replanning rate (Hz)", 30.0, min=1.0, max=100.0, step=1.0)
+        controller = gui.add_dropdown("Controller", CONTROLLERS, initial_value=CONTROLLERS[0])
+        noise = gui.add_number("Noise σ (m)", 0.0, min=0.0, max=1.0, step=0.01)
+        seed = gui.add_number("Simulation seed", 0, min=0, step=1)
+        simulate_ = gui.add_button("Simulate")
+        stop = gui.add_button("Stop")
+        status = gui.add_markdown("Simulation: ready")
+        metrics = gui.add_markdown("—")
+        t = np.array([0.0, 1.0])
+        nan = np.full(2, math.nan)
+        common = {"aspect": 2.0, "legend": {"show": True}, "scales": {"x": {"time": False}}}
+        steering = gui.add_uplot(
+            (t, nan, nan), ({"label": "t (s)"},
+                            {"label": "δ Soll (deg)", "stroke": "#e8542f", "width": 1.5},
+                            {"label": "δ Ist (deg)", "stroke": "#4a90e2", "width": 2.0}),
+            title="Steering: setpoint (Soll) vs actual (Ist)", **common)
+        lateral = gui.add_uplot(
+            (t, nan), ({"label": "t (s)"},
+                       {"label": "lateral error (cm)", "stroke": "#8e44ad", "width": 1.5}),
+            title="Lateral error to the committed path", **common)
+    return SimControls(rate, controller, noise, seed, simulate_, stop, status, metrics,
+                       steering, lateral)
+
+
+class _Stopped(Exception):
+    """Raised by the observer to end a run (`simulate` lets an observer's exception end it)."""
+
+
+class _Run:
+    """One simulation on its own thread, and what its observer leaves for the UI."""
+
+    def __init__(self, problem, settings: SimSettings) -> None:
+        self.problem = problem
+        self.frame: Frame | None = None
+        self.history: list[tuple[float, float, float, float]] = []  # t, δ set, δ, e
+        self.cycle_ms: list[float] = []
+        self.clearance, self.min_clearance = math.nan, math.inf
+        self.tree = np.zeros((0, 2, 3), np.float32)
+        self.tree_version = 0
+        self.summary: dict | None = None
+        self.error: str | None = None
+        self._tree_of, self._tree_at = None, -math.inf
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._main, args=(settings,), daemon=True,
+                                        name="studio-sim")
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+
+    @property
+    def running(self) -> bool:
+        return self._thread.is_alive()
+
+    def _main(self, settings: SimSettings) -> None:
+        try:
+            self.summary = simulate(self.problem.scenario, settings, self.problem,
+                                    observer=self._observe).summary
+        except _Stopped:
+            pass
+        except Exception as exc:  # noqa: BLE001  (shown in the status line)
+            self.error = f"{type(exc).__name__}: {exc}"
+
+    def _observe(self, f: Frame) -> None:
+        if self._stop.is_set():
+            raise _Stopped
+        self.history.append((f.t, f.steer_set, f.steer, f.lateral_error))
+        if f.cycles > len(self.cycle_ms):
+            self.cycle_ms.append(f.cycle_ms)
+        self.clearance = pose_clearance(self.problem.world, *f.pose, f.t)
+        self.min_clearance = min(self.min_clearance, self.clearance)
+        now = time.monotonic()
+        fresh = f.planner is not None and f.planner is not self._tree_of
+        if fresh and now - self._tree_at > TREE_S:
+            self._tree_of, self._tree_at = f.planner, now
+            self.tree = _tree_segments(f.planner)
+            self.tree_version += 1
+        self.frame = f
+
+
+def _tree_segments(planner) -> np.ndarray:
+    """Every edge as EDGE_PIECES straight pieces along its car path, at the tree's height."""
+    if planner.nodes < 2:
+        return np.zeros((0, 2, 3), np.float32)
+    pts = np.stack([planner.edge_points(i, EDGE_PIECES) for i in range(1, planner.nodes)])
+    seg = np.zeros((len(pts), EDGE_PIECES, 2, 3), np.float32)
+    seg[:, :, 0, :2], seg[:, :, 1, :2] = pts[:, :-1], pts[:, 1:]
+    seg[..., 2] = Z["tree"]
+    return seg.reshape(-1, 2, 3)
+
+
+def _car_ring(vehicle) -> np.ndarray:
+    """The car's outline about its rear axle, heading +x: its footprint rectangle or disc."""
+    fp = vehicle.footprint
+    if fp is None:
+        a = np.linspace(0, 2 * math.pi, 32, endpoint=False)
+        r = max(vehicle.radius, 0.05)  # a point car still shows
+        return np.column_stack([r * np.cos(a), r * np.sin(a)])
+    back = -(fp.rear_overhang if fp.rear_overhang is not None
+             else max(fp.length - vehicle.wheelbase, 0.0) / 2)
+    w = fp.width / 2
+    return np.array([[back, -w], [back + fp.length, -w], [back + fp.length, w], [back, w]])
+
+
+class SimView:
+    """The `Simulate` folder and the drawing of its runs in one session's scene."""
+
+    def __init__(self, session) -> None:
+        self.s = session
+        self.ui = build_controls(session.client.gui)
+        self.run: _Run | None = None
+        self._handles: dict[str, object] = {}
+        self._movers = np.zeros(0, np.int64)  # per scenario obstacle: its motion (-1: static)
+        self._centres: dict[int, np.ndarray] = {}  # per mover: its declared centre (m)
+        self._shown = {"frame": None, "reference": None, "path_at": 0.0, "tree": 0, "slow": 0.0}
+        self.ui.simulate.on_click(lambda _: self.start())
+        self.ui.stop.on_click(lambda _: self.stop())
+
+    # -- commands ------------------------------------------------------------------------------
+    def start(self) -> None:
+        """A new run of the session's scenario; the planner's own run is reset out of the way."""
+        u = self.ui
+        try:
+            settings = SimSettings(rate=float(u.rate.value), controller=u.controller.value,
+                                   noise=float(u.noise.value), seed=int(u.seed.value),
+                                   realtime=True)
+        except ValueError as exc:
+            self.s.notify("Simulation settings", str(exc))
+            return
+        with self.s._lock:
+            self.clear()
+            self.s.reset()
+            self._draw_static()
+            clock = self.s.ui.scene_time
+            clock.max = max(clock.max, settings.duration)
+            self.run = _Run(self.s.problem, settings)
+        u.status.content = "Simulation: **starting**"
+
+    def stop(self) -> None:
+        if self.run is not None:
+            self.run.stop()
+
+    def clear(self) -> None:
+        """Stop the run and remove its drawing (before the scene or scenario changes)."""
+        self.stop()
+        self.run = None
+        for h in self._handles.values():
+            h.remove()
+        self._handles.clear()
+        self._shown.update(frame=None, reference=None, tree=0)
+
+    # -- drawing -------------------------------------------------------------------------------
+    def _draw_static(self) -> None:
+        """Meshes drawn once per run and then only moved: the car and the movers' ghosts."""
+        scene, scn = self.s.scene, self.s.problem.scenario
+        ring = _car_ring(scn.vehicle)
+        car = scene.add_frame("/sim/car", show_axes=False, position=(*scn.start[:2], 0.0),
+                              wxyz=yaw_wxyz(scn.start[2]))
+        self._handles["car"] = car
+        _fill(scene, "/sim/car/body", [ring], SIM_Z["car"], CAR_RGB)
+        nose = np.array([[0.0, 0.0], [ring[:, 0].max(), 0.0]])
+        scene.add_line_segments(
+            "/sim/car/outline", np.concatenate([polyline_segments(ring, SIM_Z["car"], True),
+                                                polyline_segments(nose, SIM_Z["car"])]),
+            (20, 20, 20), thickness=2.5, thickness_units="screen")
+        self._movers = mover_index(scn)
+        self._centres.clear()
+        for i, ob in enumerate(scn.obstacles):
+            if self._movers[i] < 0:
+                continue
+            (x, y, yaw), local = obstacle_shape(ob)  # offsets move the declared pose
+            self._centres[i] = np.array([x, y])
+            self._handles[f"ghost{i}"] = scene.add_frame(
+                f"/sim/ghost{i}", show_axes=False, position=(x, y, 0.0), wxyz=yaw_wxyz(yaw))
+            _fill(scene, f"/sim/ghost{i}/shape", [local], SIM_Z["ghost"], GHOST_RGB,
+                  opacity=0.35)
+
+    def _put(self, name: str, seg: np.ndarray, rgb, px: float) -> None:
+        h = self._handles.get(name)
+        if h is None:
+            if len(seg):
+                self._handles[name] = self.s.scene.add_line_segments(
+                    f"/sim/{name}", seg, rgb, thickness=px, thickness_units="screen")
+        elif len(seg):
+            h.points, h.visible = seg, True
+        else:
+            h.visible = False
+
+    def tick(self) -> None:
+        """Draw what is new since the last tick (called by the session's ticker)."""
+        run = self.run
+        if run is None:
+            return
+        f = run.frame
+        if f is not None and f is not self._shown["frame"]:
+            self._shown["frame"] = f
+            self._draw_frame(f)
+        if run.tree_version != self._shown["tree"]:
+            self._shown["tree"] = run.tree_version
+            self._put("tree", run.tree, TREE_RGB, 1.0)
+        now = time.monotonic()
+        if now - self._shown["slow"] > SLOW_S or not run.running:
+            self._shown["slow"] = now
+            self._plots(run)
+            self._status(run, f)
+        if not run.running:
+            self.run = None  # finished: the last drawing stays until the next run or scenario
+
+    def _draw_frame(self, f: Frame) -> None:
+        x, y, th = f.pose
+        car = self._handles["car"]
+        car.position, car.wxyz = (x, y, 0.0), yaw_wxyz(th)
+        self.s.ui.scene_time.value = f.t  # the session draws the true movers at its clock
+        lines = []
+        for i, c in self._centres.items():
+            m, sensing = self._movers[i], f.sensing
+            if sensing is None:
+                continue
+            sensed, vel = sensing.offsets[m], sensing.velocities[m]
+            now = sensed + vel * (f.t - sensing.t)
+            self._handles[f"ghost{i}"].position = (*(c + now), 0.0)
+            lines.append([c + sensed, c + now + vel * PREDICT_S])
+        seg = np.zeros((len(lines), 2, 3), np.float32)
+        if lines:
+            seg[:, :, :2], seg[:, :, 2] = lines, SIM_Z["ghost"]
+        self._put("prediction", seg, GHOST_RGB, 2.0)
+        now = time.monotonic()
+        if (f.reference is not None and f.reference is not self._shown["reference"]
+                and now - self._shown["path_at"] > PATH_S):
+            self._shown["reference"], self._shown["path_at"] = f.reference, now
+            self._put("committed", polyline_segments(f.reference.rows[:, :2], Z["path"]),
+                      PATH_RGB, 4.0)
+
+    def _plots(self, run: _Run) -> None:
+        h = run.history[:]
+        if len(h) < 2:
+            return
+        t = np.array([r[0] for r in h])
+        keep = np.flatnonzero(t >= t[-1] - WINDOW_S)
+        keep = keep[:: max(1, len(keep) // PLOT_POINTS)]
+        a = np.array(h)[keep]
+        self.ui.steering.data = (a[:, 0], np.degrees(a[:, 1]), np.degrees(a[:, 2]))
+        a = a[np.isfinite(a[:, 3])]  # no error before the first plan; uPlot cannot scale NaN
+        if len(a):
+            self.ui.lateral.data = (a[:, 0], 100.0 * a[:, 3])
+
+    def _status(self, run: _Run, f: Frame | None) -> None:
+        if run.error:
+            text = f"Simulation: **failed** — {run.error}"
+        elif run.summary is not None:
+            sm = run.summary
+            end = (f"goal reached at t = {sm['time_to_goal_s']:.2f} s" if sm["reached_goal"]
+                   else f"goal not reached in {sm['duration_s']:.1f} s")
+            text = f"Simulation: **done** — {end}, {sm['collisions']} collisions"
+        elif not run.running:
+            text = "Simulation: **stopped**"
+        else:
+            text = "Simulation: **running**" if f is not None else "Simulation: **starting**"
+        if text != self.ui.status.content:
+            self.ui.status.content = text
+        if f is None:
+            return
+        ms = np.array(run.cycle_ms)
+        self.ui.metrics.content = "\n".join([
+            f"| t | {f.t:.2f} s |", "|---|---|",
+            f"| speed | {f.v:.2f} m/s |",
+            f"| cycles | {f.cycles} |",
+            f"| replans | {f.replans} |",
+            f"| cycle ms (last, p50) | {f.cycle_ms:.1f}, {np.median(ms):.1f} |",
+            f"| clearance (now, min) | {run.clearance:.3f} m, {run.min_clearance:.3f} m |",
+            f"| tree nodes | {f.planner.nodes if f.planner is not None else 0} |",
+        ])
