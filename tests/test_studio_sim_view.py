@@ -1,0 +1,65 @@
+"""The studio's simulation view without a browser: a real viser server (no client connected),
+a stand-in session, the crossing scenario; what `SimView.tick` draws is the frame it drew."""
+
+from __future__ import annotations
+
+import threading
+import time
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+import viser
+from conftest import SCENARIOS
+
+import planner
+from app.studio._scene import yaw_wxyz
+from app.studio._sim_view import EDGE_PIECES, SimView
+
+
+@pytest.fixture
+def view():
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    problem = planner.compile_problem(planner.load_scenario(SCENARIOS / "crossing.json"))
+    session = SimpleNamespace(
+        client=SimpleNamespace(gui=server.gui), scene=server.scene, problem=problem,
+        ui=SimpleNamespace(scene_time=server.gui.add_slider("Scene time (s)", 0.0, 30.0, 0.1,
+                                                            0.0)),
+        _lock=threading.RLock(), reset=lambda: None, notify=lambda *a: None)
+    sim = SimView(session)
+    yield sim
+    sim.clear()
+    server.stop()
+
+
+def test_the_view_draws_the_frame_it_received(view):
+    view.start()
+    run = view.run
+    deadline = time.monotonic() + 60
+    while (run.frame is None or run.frame.t < 1.5 or run.tree_version == 0) and (
+            time.monotonic() < deadline):
+        time.sleep(0.05)
+    view.tick()
+    f = view._shown["frame"]
+    assert f is not None and f.t >= 1.5
+    car = view._handles["car"]
+    assert np.allclose(car.position, (*f.pose[:2], 0.0))
+    assert np.allclose(car.wxyz, yaw_wxyz(f.pose[2]))
+    assert view.s.ui.scene_time.value == pytest.approx(f.t)  # the true mover, at the clock
+    # The ghost: the last sensing, extrapolated at constant velocity to the frame's time.
+    s = f.sensing
+    believed = np.array([10.0, -1.3]) + s.offsets[0] + s.velocities[0] * (f.t - s.t)
+    assert np.allclose(view._handles["ghost0"].position[:2], believed)
+    assert np.allclose(believed, np.array([10.0, -1.3]) + f.offsets[0], atol=0.01)  # no noise
+    assert view._handles["committed"].points.shape[0] == len(view._shown["reference"].rows) - 1
+    assert len(view._handles["tree"].points) % EDGE_PIECES == 0
+    assert len(view._handles["tree"].points) > 0
+    t, soll, ist = view.ui.steering.data
+    assert len(t) == len(soll) == len(ist) > 10
+    assert "running" in view.ui.status.content and "| cycles |" in view.ui.metrics.content
+    view.stop()
+    deadline = time.monotonic() + 10
+    while run.running and time.monotonic() < deadline:
+        time.sleep(0.05)
+    view.tick()
+    assert "stopped" in view.ui.status.content and view.run is None
