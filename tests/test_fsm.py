@@ -118,16 +118,16 @@ def test_ultrasonic_cone_and_lane_see_off_axis_posts_a_single_ray_misses():
 
 # -- transitions -----------------------------------------------------------------------------
 def test_always_gives_a_state_exactly_one_tick():
-    run = _drive(_scene(), [_state("a", "Idle", transitions=[_to("b", "Always"), _to("c", "Always")]),
-                            _state("b", "Stop"), _state("c", "Stop")])
+    first = _state("a", "Idle", transitions=[_to("b", "Always"), _to("c", "Always")])
+    run = _drive(_scene(), [first, _state("b", "Stop"), _state("c", "Stop")])
     assert _states(run) == ["a", "b"]  # the first listed transition wins; Stop at rest ends it
     assert run.summary["behaviour"]["transitions"] == [{"t": DT, "from": "a", "to": "b"}]
     assert run.summary["behaviour"]["final_state"] == "b"
 
 
 def test_distance_fires_at_the_tick_the_state_has_driven_its_metres():
-    run = _drive(_scene(), [_state("a", "ApproachPoint", AHEAD, [_to("stop", "Distance", meters=3.0)]),
-                            STOP])
+    run = _drive(_scene(), [
+        _state("a", "ApproachPoint", AHEAD, [_to("stop", "Distance", meters=3.0)]), STOP])
     k, driven = _first(run, "stop"), _driven(run)
     assert driven[k] >= 3.0 > driven[k - 1]
     assert _col(run, "x")[k] - 1.0 == pytest.approx(driven[k], abs=1e-9)  # a straight line
