@@ -5,9 +5,9 @@ A run goes on its own thread (`simulate(..., realtime=True)`); its observer keep
 since a planner's arrays are only safe to read on the thread that runs it. The session's ticker
 calls `SimView.tick`, which draws the latest state: the car; the movers where they truly are
 (the session's own obstacles, its scene clock set to the simulation's time); where the car
-believes they are (translucent ghosts, extrapolated from the last sensing at
-constant velocity, with a line to where it predicts them ``PREDICT_S`` later), the committed
-path, the tree, Soll/Ist steering and lateral error plots and the metrics.
+believes they are (translucent ghosts: the last sensing extrapolated at constant velocity, with
+a line to where it predicts them ``PREDICT_S`` later); the committed path, the tree, Soll/Ist
+steering and lateral error plots and the metrics.
 """
 
 from __future__ import annotations
@@ -251,6 +251,7 @@ class SimView:
         run = self.run
         if run is None:
             return
+        finished = not run.running  # read first: then the frame below is the run's last
         f = run.frame
         if f is not None and f is not self._shown["frame"]:
             self._shown["frame"] = f
@@ -259,11 +260,11 @@ class SimView:
             self._shown["tree"] = run.tree_version
             self._put("tree", run.tree, TREE_RGB, 1.0)
         now = time.monotonic()
-        if now - self._shown["slow"] > SLOW_S or not run.running:
+        if now - self._shown["slow"] > SLOW_S or finished:
             self._shown["slow"] = now
             self._plots(run)
             self._status(run, f)
-        if not run.running:
+        if finished:
             self.run = None  # finished: the last drawing stays until the next run or scenario
 
     def _draw_frame(self, f: Frame) -> None:
