@@ -13,7 +13,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from planner.report import PlanReport
 
-__all__ = ["PlanOptions", "Seed", "TrackSource", "check_scenario", "run_plan"]
+__all__ = ["PlanOptions", "Seed", "TrackSource", "check_scenario", "run_plan", "track_loader"]
 
 PositiveFinite = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 Seed = Annotated[int, Field(ge=0, lt=2**64)]
@@ -57,8 +57,8 @@ class TrackSource(BaseModel):
     unit: str | None = None
 
 
-def _compile(scenario, track: TrackSource | None):
-    import planner as core
+def track_loader(track: TrackSource | None):
+    """``load_track(name)`` for `planner.compile_problem`: the uploaded track, else the library."""
     import tracks
 
     def load_track(name: str):
@@ -66,9 +66,15 @@ def _compile(scenario, track: TrackSource | None):
             return tracks.load_svg(track.svg, path_id=track.path, unit=track.unit)
         return tracks.load_library_track(name)
 
+    return load_track
+
+
+def _compile(scenario, track: TrackSource | None):
+    import planner as core
+
     if not isinstance(scenario, core.Scenario):
         scenario = core.parse_scenario(scenario)
-    return core.compile_problem(scenario, load_track=load_track)
+    return core.compile_problem(scenario, load_track=track_loader(track))
 
 
 def check_scenario(scenario, track: TrackSource | None = None) -> None:

@@ -13,7 +13,8 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
 
-from app.server import routes_jobs, routes_plan, routes_scenarios, routes_tracks
+from app.server import (routes_jobs, routes_plan, routes_scenarios, routes_simulations,
+                        routes_tracks)
 from app.server.jobs import Planning
 from app.server.models import Health
 from app.server.store import Store
@@ -93,7 +94,8 @@ def create_app(settings: ServerSettings) -> FastAPI:
     app = FastAPI(
         title="Trackstar",
         version=version("trackstar"),
-        description="Tracks, scenarios, RRT/RRT* plans and batch jobs for car-like robots.",
+        description="Tracks, scenarios, RRT/RRT* plans, batch jobs and simulated runs for "
+                    "car-like robots.",
         lifespan=lifespan,
     )
     app.state.settings = settings
@@ -123,6 +125,7 @@ def create_app(settings: ServerSettings) -> FastAPI:
         return FileResponse(STATIC / "index.html")
 
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
-    for module in (routes_tracks, routes_scenarios, routes_plan, routes_jobs):
+    for module in (routes_tracks, routes_scenarios, routes_plan, routes_jobs,
+                   routes_simulations):
         app.include_router(module.router, prefix="/api/v1")
     return app

@@ -16,9 +16,11 @@ import os
 import signal
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
+from pathlib import Path
 
 from app.planning import PlanOptions, TrackSource, check_scenario, run_plan
 from app.server.store import Store
+from app.simulation import SimOptions, read_progress, run_simulation
 from planner.report import PlanReport
 from planner.rrt import warm_up
 
@@ -52,7 +54,9 @@ class Planning:
         self.max_plan_s = max_plan_s
         self.workers = workers or machine_workers()
         self.pool = self._start_pool()
-        self._jobs: dict[str, asyncio.Task] = {}
+        self._jobs: dict[str, asyncio.Task] = {}  # batch jobs and simulations
+        self.sim_dir = store.path.parent / "simulations"  # per-run log CSV and progress files
+        self.sim_dir.mkdir(exist_ok=True)
         store.fail_unfinished(CRASHED)
 
     def _start_pool(self) -> ProcessPoolExecutor:
@@ -109,6 +113,35 @@ class Planning:
             self.store.set_job_status(job_id, "done")
         finally:
             self._jobs.pop(job_id, None)
+
+    def start_simulation(self, scenario: dict, options: SimOptions,
+                         track: TrackSource | None) -> str:
+        """Store a simulation and run it in the background on the pool; returns its id."""
+        sim_id = self.store.add_simulation(scenario["name"], options.model_dump())
+        task = self._simulate(sim_id, scenario, options, track)
+        self._jobs[sim_id] = asyncio.get_running_loop().create_task(task)
+        return sim_id
+
+    def sim_log(self, sim_id: str) -> Path:
+        return self.sim_dir / f"{sim_id}.csv"
+
+    def sim_time(self, sim_id: str) -> float:
+        """Simulated seconds a running simulation has reached."""
+        return read_progress(self.sim_dir / f"{sim_id}.progress")
+
+    async def _simulate(self, sim_id: str, scenario: dict, options: SimOptions, track) -> None:
+        progress = self.sim_dir / f"{sim_id}.progress"
+        try:
+            self.store.set_simulation(sim_id, "running")
+            summary = await self._call(run_simulation, scenario, options, track,
+                                       self.sim_log(sim_id), progress)
+        except Exception as exc:  # a bad scenario, bad settings or a dead worker: say which
+            self.store.set_simulation(sim_id, "failed", error=first_line(exc))
+        else:
+            self.store.set_simulation(sim_id, "done", summary=summary)
+        finally:
+            progress.unlink(missing_ok=True)
+            self._jobs.pop(sim_id, None)
 
     def cancel(self, job_id: str) -> None:
         self.store.set_job_status(job_id, "cancelled")

@@ -11,6 +11,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from app.planning import PlanOptions, Seed
+from app.simulation import SimOptions
 from planner.report import PlanReport
 
 Point = tuple[float, float]
@@ -158,3 +159,42 @@ class JobStatus(BaseModel):
     total: int
     error: str | None = None
     results: list[JobResult]
+
+
+class SimulationRequest(SimOptions):
+    """One simulated run: a scenario inline or by id, and the options of `trackstar simulate`."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [
+        {"scenario": SCENARIO_EXAMPLE, "duration": 20, "seed": 1},
+        {"scenario_id": "<a stored thesis-track scenario>", "laps": 2}]})
+
+    scenario: dict[str, Any] | None = Field(
+        None, description="FORMAT.md or the rich schema (GET /scenarios/schema)")
+    scenario_id: str | None = None
+
+    @model_validator(mode="after")
+    def _one_scenario(self) -> SimulationRequest:
+        if (self.scenario is None) == (self.scenario_id is None):
+            raise ValueError("give exactly one of 'scenario' and 'scenario_id'")
+        return self
+
+    def options(self) -> SimOptions:
+        return SimOptions(**self.model_dump(exclude={"scenario", "scenario_id"}))
+
+
+class SimulationCreated(BaseModel):
+    id: str
+
+
+class SimulationStatus(BaseModel):
+    """A simulation's state; ``summary`` is the object of `trackstar simulate --json` once done."""
+
+    id: str
+    status: Literal["queued", "running", "done", "failed", "cancelled"]
+    scenario: str = Field(description="the scenario's name")
+    settings: dict[str, Any] = Field(description="the options it runs with")
+    sim_time_s: float = Field(description="simulated seconds reached so far")
+    progress: float = Field(description="sim_time_s / duration, 1 when done (a run that "
+                                        "reaches its goal or finishes its laps ends early)")
+    error: str | None = None
+    summary: dict[str, Any] | None = None

@@ -1,4 +1,5 @@
-"""The server's data: one SQLite file (WAL) with uploaded tracks, scenarios and batch jobs.
+"""The server's data: one SQLite file (WAL) with uploaded tracks, scenarios, batch jobs and
+simulations (their per-tick logs are CSV files beside it, see `jobs.Planning`).
 
 Schema changes are appended to `MIGRATIONS`; `schema_version` records how many have run, so a
 data directory from an older release is upgraded on start and never rebuilt. One connection is
@@ -32,6 +33,11 @@ MIGRATIONS = [
                               idx INTEGER NOT NULL, body TEXT NOT NULL,
                               PRIMARY KEY (job_id, idx));
     """,
+    """
+    CREATE TABLE simulations (id TEXT PRIMARY KEY, status TEXT NOT NULL, scenario TEXT NOT NULL,
+                              settings TEXT NOT NULL, summary TEXT, error TEXT,
+                              created REAL NOT NULL);
+    """,
 ]
 
 
@@ -44,6 +50,7 @@ class Store:
 
     def __init__(self, path: Path) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
+        self.path = path
         self._db = sqlite3.connect(path, check_same_thread=False, isolation_level=None)
         self._db.row_factory = sqlite3.Row
         self._lock = threading.Lock()
@@ -140,11 +147,38 @@ class Store:
         self._write("INSERT INTO job_results VALUES (?, ?, ?)", job_id, idx, json.dumps(body))
 
     def fail_unfinished(self, error: str) -> list[str]:
-        """Mark every queued or running job failed (at shutdown, and on start after a crash)."""
+        """Mark every queued or running job and simulation failed (at shutdown, and on start
+        after a crash)."""
         ids = [r["id"] for r in self._all(f"SELECT id FROM jobs WHERE status IN {UNFINISHED}")]
         for job_id in ids:
             self.set_job_status(job_id, "failed", error)
-        return ids
+        sims = [r["id"] for r in self._all(
+            f"SELECT id FROM simulations WHERE status IN {UNFINISHED}")]
+        for sim_id in sims:
+            self.set_simulation(sim_id, "failed", error=error)
+        return ids + sims
+
+    # simulations
+    def add_simulation(self, scenario: str, settings: dict[str, Any]) -> str:
+        sim_id = new_id()
+        self._write("INSERT INTO simulations VALUES (?, 'queued', ?, ?, NULL, NULL, ?)", sim_id,
+                    scenario, json.dumps(settings), time.time())
+        return sim_id
+
+    def simulation(self, sim_id: str) -> dict | None:
+        row = self._one("SELECT id, status, scenario, settings, summary, error FROM simulations "
+                        "WHERE id = ?", sim_id)
+        if row is not None:
+            for key in ("settings", "summary"):
+                row[key] = json.loads(row[key]) if row[key] is not None else None
+        return row
+
+    def set_simulation(self, sim_id: str, status: str, *, summary: dict | None = None,
+                       error: str | None = None) -> None:
+        """Move an unfinished simulation on; a finished one stays as it is."""
+        self._write(f"UPDATE simulations SET status = ?, summary = ?, error = ? WHERE id = ? "
+                    f"AND status IN {UNFINISHED}", status,
+                    json.dumps(summary) if summary is not None else None, error, sim_id)
 
 
 def _scenario(row: dict) -> dict:

@@ -1,0 +1,86 @@
+"""Options → simulation: what POST /simulations runs in a worker process.
+
+`SimOptions` are the options of `trackstar simulate` (same names, same defaults) as the API's
+body fields; `run_simulation` is a plain top-level function so that the server's worker
+processes can run it. It reports progress through a small file the server reads, because a
+pool worker has no other channel back while its call is running.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from app.planning import PositiveFinite, Seed, TrackSource, track_loader
+
+__all__ = ["MAX_DURATION_S", "SimOptions", "read_progress", "run_simulation"]
+
+MAX_DURATION_S = 600.0  # simulated seconds per run: a worker is busy for up to about half that
+PROGRESS_EVERY_S = 0.25  # wall time between progress writes
+
+
+class SimOptions(BaseModel):
+    """How to simulate: the options of `trackstar simulate`, with the same defaults."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    duration: Annotated[float, Field(gt=0, le=MAX_DURATION_S, allow_inf_nan=False)] = Field(
+        60.0, description="simulated seconds at most")
+    rate: PositiveFinite = Field(30.0, description="replanning cycles per second")
+    control_rate: PositiveFinite = Field(100.0, description="control ticks per second")
+    sense_rate: PositiveFinite = Field(10.0, description="sensing instants per second")
+    controller: Literal["pure-pursuit", "stanley", "pd"] = "pure-pursuit"
+    noise: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+        0.0, description="σ (m) of sensed positions; the heading gets √2·σ/wheelbase (rad)")
+    laps: Annotated[int, Field(ge=1, le=1000)] | None = Field(
+        None, description="drive this many laps of the scenario's closed track (rich schema)")
+    seed: Seed = 0
+    fixed_latency_ms: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = Field(
+        None, description="a fixed cycle time instead of the measured one (reproducible logs)")
+    replan: bool = Field(True, description="false: plan once at t = 0 and follow it blind")
+
+    def settings(self):
+        """The `planner.sim.SimSettings` of these options (raises ValueError when invalid)."""
+        from planner.sim import SimSettings
+
+        return SimSettings(**self.model_dump())
+
+
+def run_simulation(scenario: dict, options: SimOptions, track: TrackSource | None,
+                   log_path: Path, progress_path: Path) -> dict:
+    """Simulate, write the per-tick log CSV to ``log_path`` and return the JSON summary.
+
+    While running, the simulated time reached is written to ``progress_path`` about every
+    quarter second of wall time (replaced atomically, so a reader never sees half a number).
+    """
+    import planner as core
+    from planner.sim import simulate
+
+    load_track = track_loader(track)
+    problem = core.compile_problem(core.parse_scenario(scenario), load_track=load_track)
+    written = time.monotonic()
+
+    def progress(frame) -> None:
+        nonlocal written
+        if time.monotonic() - written >= PROGRESS_EVERY_S:
+            written = time.monotonic()
+            partial = progress_path.with_suffix(".tmp")
+            partial.write_text(f"{frame.t:.3f}")
+            os.replace(partial, progress_path)
+
+    run = simulate(problem.scenario, options.settings(), problem, load_track=load_track,
+                   observer=progress)
+    run.write_log(log_path)
+    return run.summary
+
+
+def read_progress(progress_path: Path) -> float:
+    """Simulated seconds reached so far (0 before the first write)."""
+    try:
+        return float(progress_path.read_text())
+    except (FileNotFoundError, ValueError):
+        return 0.0
