@@ -7,6 +7,7 @@ own studio session. Screenshots land in tests/artifacts/studio/ for a human to l
 from __future__ import annotations
 
 import io
+import json
 import os
 import re
 import shutil
@@ -31,25 +32,32 @@ pytestmark = pytest.mark.skipif(not os.path.exists(CHROMIUM) and not os.environ.
 
 
 @pytest.fixture(scope="module")
-def ui_url(tmp_path_factory):
+def urls(tmp_path_factory):
+    """The studio's and the REST API's base URLs of one `trackstar serve`."""
     exe = shutil.which("trackstar")
     cmd = ([exe] if exe else [sys.executable, "-m", "app.cli"]) + [
         "serve", "--port", "0", "--ui-port", "0", "--data-dir",
         str(tmp_path_factory.mktemp("data"))]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    url, seen = None, []
+    found, seen = {}, []
     deadline = time.monotonic() + 120
-    while url is None and time.monotonic() < deadline:
+    while "ui" not in found and time.monotonic() < deadline:
         line = proc.stdout.readline()
         if not line:
             break
         seen.append(line)
-        m = re.match(r"UI: (http://\S+)", line)
-        url = m.group(1) if m else None
-    assert url, "trackstar serve printed no UI line:\n" + "".join(seen[-20:])
-    yield url
+        m = re.match(r"(API|UI): (http://[^/\s]+)", line)
+        if m:
+            found[m.group(1).lower()] = m.group(2)
+    assert "ui" in found, "trackstar serve printed no UI line:\n" + "".join(seen[-20:])
+    yield {"ui": found["ui"] + "/", "api": found["api"] + "/api/v1"}
     proc.terminate()
     proc.wait(timeout=10)
+
+
+@pytest.fixture(scope="module")
+def ui_url(urls):
+    return urls["ui"]
 
 
 @pytest.fixture(scope="module")
@@ -215,3 +223,170 @@ def test_two_tabs_are_independent_sessions(browser, ui_url):
     assert b.locator("tr", has_text="iterations").count() == 0  # b never ran
     a.close()
     b.close()
+
+
+# -- editing: drag, polygons, driving, the scenario store ---------------------------------------
+def red(img: np.ndarray) -> np.ndarray:
+    """Where static obstacles are drawn, (200, 60, 60) once shaded."""
+    return np.abs(img - [210, 51, 54]).sum(axis=2) < 50
+
+
+def centroid(mask: np.ndarray) -> np.ndarray:
+    ys, xs = np.nonzero(mask)
+    return np.array([xs.mean(), ys.mean()])
+
+
+def gizmo_square(img: np.ndarray, near: np.ndarray, radius: int = 70) -> np.ndarray:
+    """Screen position of the plane-drag square of the gizmo nearest ``near``: the densest
+    patch of its blue (54, 142, 226) within ``radius`` pixels (the turn arc is thinner)."""
+    blue = (np.abs(img - [54, 142, 226]).sum(axis=2) < 30).astype(int)
+    c = np.cumsum(np.cumsum(np.pad(blue, ((1, 0), (1, 0))), axis=0), axis=1)
+    k = 9  # a k × k box filter
+    dense = c[k:, k:] - c[:-k, k:] - c[k:, :-k] + c[:-k, :-k]
+    ys, xs = np.mgrid[:dense.shape[0], :dense.shape[1]]
+    dense[np.hypot(xs + k / 2 - near[0], ys + k / 2 - near[1]) > radius] = 0
+    y, x = np.unravel_index(np.argmax(dense), dense.shape)
+    assert dense[y, x] > k * k // 2, "no gizmo square near the obstacle"
+    return np.array([x + k / 2, y + k / 2])
+
+
+def drag(page, a, b) -> None:
+    page.mouse.move(*a)
+    page.mouse.down()
+    page.mouse.move(*b, steps=12)
+    page.mouse.up()
+
+
+def show_folder(page, title: str, control: str) -> None:
+    """Expand a collapsed GUI folder unless ``control`` (a button in it) is visible."""
+    if not page.get_by_role("button", name=control, exact=True).is_visible():
+        page.get_by_text(title, exact=True).click()
+        page.get_by_role("button", name=control, exact=True).wait_for()
+
+
+def download_scenario(page) -> dict:
+    show_folder(page, "Scenario", "Download scenario (JSON)")
+    with page.expect_download() as dl:
+        click(page, "Download scenario (JSON)")
+    return json.loads(Path(dl.value.path()).read_text())
+
+
+def set_text(page, label: str, text: str) -> None:
+    """Type into a text field (viser's text inputs lack the id their label points to)."""
+    field = page.locator(f'xpath=//label[text()="{label}"]/ancestor::div[.//input][1]//input')
+    field.fill(text)
+    field.press("Enter")
+
+
+def poll(fn, ok, timeout: float = 15.0):
+    deadline = time.monotonic() + timeout
+    while True:
+        value = fn()
+        if ok(value) or time.monotonic() > deadline:
+            return value
+        time.sleep(0.5)
+
+
+def test_dragging_an_obstacle_moves_it_in_the_scenario(browser, ui_url):
+    page = open_tab(browser, ui_url)
+    click(page, "Add box")
+    img = wait_until(page, lambda img: red(img).sum() > 300)
+    wait_still(page)
+    img = canvas_pixels(page, "08_box_with_gizmos")
+    box = centroid(red(img))
+    before = download_scenario(page)["obstacles"][0]
+    square = gizmo_square(img, box)
+    drag(page, square, square + [150, 60])  # right and down on screen: +x, -y in the world
+    after = poll(lambda: download_scenario(page)["obstacles"][0],
+                 lambda ob: ob["center"] != before["center"])
+    dx, dy = np.subtract(after["center"], before["center"])
+    assert dx > 0.3 and dy < -0.1, (before, after)
+    assert after["size"] == before["size"] and after["angle_deg"] == before["angle_deg"]
+    time.sleep(1.0)
+    wait_still(page)
+    moved = centroid(red(canvas_pixels(page, "09_box_dragged")))
+    assert np.allclose(moved - box, [150, 60], atol=25), (box, moved)  # drawn where dropped
+    page.close()
+
+
+def test_a_polygon_clicked_on_the_ground_becomes_an_obstacle(browser, ui_url):
+    page = open_tab(browser, ui_url)
+    page.get_by_text("Polygon (click the ground)").click()
+    corners = [(420, 785), (520, 780), (540, 835), (430, 845)]  # on the bottom straight
+    for n, xy in enumerate(corners, 1):
+        page.mouse.click(*xy)
+        page.get_by_text(f"— {n} corners").wait_for(timeout=10000)
+    click(page, "Close polygon")
+    img = wait_until(page, lambda img: red(img).sum() > 2000)
+    wait_still(page)
+    img = canvas_pixels(page, "10_polygon")
+    assert red(img).sum() > 2000, "the polygon is not drawn"
+    assert np.allclose(centroid(red(img)), np.mean(corners, axis=0), atol=20)
+    ob = download_scenario(page)["obstacles"][0]
+    assert ob["type"] == "polygon" and len(ob["points"]) == 4
+    page.close()
+
+
+def car_pixels(img: np.ndarray) -> np.ndarray:
+    """The driving car's outline, (20, 20, 20)."""
+    return img.sum(axis=2) < 80
+
+
+def test_drive_car_moves_the_footprint_along_the_best_path(browser, ui_url):
+    page = open_tab(browser, ui_url)
+    click(page, "Run")
+    wait_until(page, lambda img: (np.abs(img - [255, 90, 200]).sum(axis=2) < 60).sum() > 200,
+               timeout=30)
+    click(page, "Pause")
+    time.sleep(1.0)
+    click(page, "Drive car")
+    first = wait_until(page, lambda img: car_pixels(img).sum() > 30)
+    time.sleep(1.5)
+    later = canvas_pixels(page, "11_drive_car")
+    assert car_pixels(first).sum() > 30 and car_pixels(later).sum() > 30, "no car drawn"
+    moved = np.linalg.norm(centroid(car_pixels(later)) - centroid(car_pixels(first)))
+    assert moved > 40, f"the car moved {moved:.0f} px in 1.5 s"
+    page.close()
+
+
+SMALL_SVG = """<svg xmlns="http://www.w3.org/2000/svg" width="320mm" height="180mm"
+ viewBox="0 0 320 180"><path id="small" d="M 60 30 H 260 A 60 60 0 0 1 260 150 H 60
+ A 60 60 0 0 1 60 30 Z" style="stroke-width:30;fill:none"/></svg>"""
+
+
+def test_a_scenario_saved_to_the_server_loads_back_with_its_track(browser, urls, tmp_path):
+    """A 30 cm track drawn in mm: the view fits it; saved to the server's store with a box,
+    the scenario embeds the track, and a new tab that loads it by name shows both again."""
+    import httpx
+
+    page = open_tab(browser, urls["ui"])
+    thesis = canvas_pixels(page)
+    svg = tmp_path / "small.svg"
+    svg.write_text(SMALL_SVG)
+    page.locator("input[type=file]").first.set_input_files(str(svg))
+    click(page, "Add box")
+    wait_until(page, lambda img: red(img).sum() > 100 and asphalt(img) > 0.1)
+    wait_still(page)
+    saved = canvas_pixels(page, "12_small_track")
+    assert asphalt(saved) > 0.1, "the 30 cm track is not in view"
+    show_folder(page, "Scenario", "Save to server")
+    set_text(page, "Name", "small-loop")
+    click(page, "Save to server")
+    page.get_by_text("Saved").wait_for(timeout=15000)
+    stored = [r for r in httpx.get(f"{urls['api']}/scenarios").json()
+              if r["name"] == "small-loop"]
+    assert len(stored) == 1
+    scenario = stored[0]["scenario"]
+    assert "<svg" in scenario["track"]["svg"] and scenario["obstacles"][0]["type"] == "box"
+    page.close()
+
+    other = open_tab(browser, urls["ui"])
+    show_folder(other, "Scenario", "Load from server")
+    set_text(other, "Name", "small-loop")
+    click(other, "Load from server")
+    loaded = wait_until(other, lambda img: red(img).sum() > 100)
+    wait_still(other)
+    loaded = canvas_pixels(other, "13_small_track_loaded")
+    same = (np.abs(loaded - saved).sum(axis=2) < 60).mean()
+    assert same > 0.9 and (np.abs(thesis - saved).sum(axis=2) < 60).mean() < same
+    other.close()

@@ -118,8 +118,14 @@ class Track:
         normal = np.column_stack([-np.sin(prof.heading), np.cos(prof.heading)])
         return centre + half * normal, centre - half * normal
 
-    def region_rings(self, spacing: float = 0.05) -> list[np.ndarray]:
-        """The drivable region as polygon rings (each (N, 2), not repeating its first point).
+    def detail_spacing(self) -> float:
+        """A sampling step that shows the track's shape: 5 cm, finer on a narrow track (a
+        quarter of its width), so a 30 cm track drawn in millimetres keeps its curves."""
+        return min(0.05, self.width_m / 4.0)
+
+    def region_rings(self, spacing: float | None = None) -> list[np.ndarray]:
+        """The drivable region as polygon rings (each (N, 2), not repeating its first point),
+        sampled every ``spacing`` m (default `detail_spacing`).
 
         The sampled centreline is buffered by width/2 (flat ends, mitred joins), which stays
         right where the offset curves fold. A loop gives [outer, inner], a road one ring; any
@@ -127,7 +133,7 @@ class Track:
         """
         import shapely
 
-        prof = self.sample(spacing)
+        prof = self.sample(spacing or self.detail_spacing())
         centre = np.column_stack([prof.x, prof.y])
         line = shapely.LinearRing(centre[:-1]) if self.closed else shapely.LineString(centre)
         region = line.buffer(self.width_m / 2.0, cap_style="flat", join_style="mitre")

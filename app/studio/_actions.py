@@ -44,7 +44,8 @@ def wire(s) -> None:
     u.set_motion.on_click(lambda _: _set_motion(s))
     u.scene_time.on_update(lambda _: s.show_time(u.scene_time.value))
     u.scenario_download.on_click(lambda _: s.client.send_file_download(
-        f"{u.scenario_name.value or 'studio'}.json", s.scenario_json().encode()))
+        f"{u.scenario_name.value or 'studio'}.json", s.scenario_json().encode(),
+        save_immediately=True))
     u.scenario_upload.on_upload(lambda _: _scenario_uploaded(s))
     u.scenario_save.on_click(lambda _: _save_to_server(s))
     u.scenario_load.on_click(lambda _: _load_from_server(s))
@@ -118,14 +119,15 @@ def _use_drawn(s) -> None:
 def _download_svg(s) -> None:
     track = _drawn_track(s) if s.draft.points else s.track
     if track is not None:
-        s.client.send_file_download(f"{track.name or 'track'}.svg", track.to_svg().encode())
+        s.client.send_file_download(f"{track.name or 'track'}.svg", track.to_svg().encode(),
+                                    save_immediately=True)
 
 
 # -- obstacles --------------------------------------------------------------------------------
 def _add_obstacle(s, kind: str) -> None:
     """A new obstacle on the centreline, between start and goal, away from the others."""
     track = s.track
-    prof = track.sample(0.05)
+    prof = track.sample(track.detail_spacing())
     n = len(s.scenario["obstacles"])
     frac = (0.2 + 0.15 * (n % 4)) * (0.75 if track.closed else 0.9)
     i = int(np.searchsorted(prof.s, frac * track.length_m))

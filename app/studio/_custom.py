@@ -21,7 +21,7 @@ __all__ = ["Draft", "custom_scenario"]
 
 def custom_scenario(track: tracks.Track, name: str) -> dict:
     """A scenario embedding ``track`` (start at s = 0, goal 3/4 lap or 90 % along)."""
-    prof = track.sample(spacing=0.05)
+    prof = track.sample(track.detail_spacing())
     start_s = 0.0 if track.closed else 0.05 * track.length_m
     return {
         "name": name,

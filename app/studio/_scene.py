@@ -73,7 +73,7 @@ def draw_track(scene, track, kappa_max: float) -> None:
     for i, ring in enumerate(rings):
         scene.add_line_segments(f"/track/edge{i}", polyline_segments(ring, 0.0, closed=True),
                                 (235, 235, 235), thickness=2.0, thickness_units="screen")
-    prof = track.sample(spacing=0.05)
+    prof = track.sample(track.detail_spacing())
     seg = polyline_segments(np.column_stack([prof.x, prof.y]), Z["centre"])
     col = curvature_colors(prof.curvature, kappa_max)
     colors = np.stack([col[:-1], col[1:]], axis=1)
@@ -194,21 +194,27 @@ def add_grid(scene, bounds) -> None:
                    cell_color=(225, 225, 225), section_color=(190, 190, 190))
 
 
-def fit_camera(client, bounds, fov_deg: float = 20.0, usable: float = 0.72) -> None:
+def fit_camera(client, bounds, fov_deg: float = 20.0, usable: float = 0.72,
+               min_height: float = 20.0) -> None:
     """Look straight down on ``bounds`` with a narrow field of view (nearly orthographic),
     slightly off the pole so the orbit controls keep +y up on screen. The GUI panel covers the
-    right of the canvas, so the scene is centred in the left ``usable`` fraction."""
+    right of the canvas, so the scene is centred in the left ``usable`` fraction.
+
+    The layers sit millimetres to centimetres apart in height (`Z`); seen from close above, a
+    small track (30 cm drawn in mm) would show them shifted by parallax. So the camera never
+    comes below ``min_height`` m: a small scene narrows the field of view instead."""
     xmin, ymin, xmax, ymax = bounds
     cx, cy = (xmin + xmax) / 2, (ymin + ymax) / 2
     tanf = math.tan(math.radians(fov_deg) / 2)
     aspect = client.camera.aspect if client.camera.aspect > 0 else 1.5
     h = max(0.55 * (ymax - ymin) / tanf, 0.55 * (xmax - xmin) / usable / (tanf * aspect))
+    if h < min_height:
+        tanf, h = tanf * h / min_height, min_height
     cx += (1 - usable) * tanf * aspect * h  # the scene's centre at usable / 2 across
     with client.atomic():
-        client.camera.fov = math.radians(fov_deg)
+        client.camera.fov = 2 * math.atan(tanf)
         client.camera.up_direction = (0.0, 0.0, 1.0)
-        # Small tracks (an SVG in millimetres) need the camera closer than viser's default
-        # closest orbit distance.
+        # Zooming in 20× needs the camera closer than viser's default closest orbit distance.
         client.camera.min_orbit_distance = min(0.05 * h, client.camera.max_orbit_distance)
         client.camera.near = 0.01 * h
         client.camera.position = (cx, cy - 0.01 * h, h)

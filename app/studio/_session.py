@@ -27,6 +27,7 @@ from app.studio._plots import Profiles
 from app.studio._scenario import default_scenario, goal_fraction
 from app.studio._scene import (
     Z,
+    _fill,
     add_grid,
     car_outline,
     draw_obstacles,
@@ -34,7 +35,6 @@ from app.studio._scene import (
     draw_track,
     fit_camera,
     move_obstacles,
-    polyline_segments,
     yaw_wxyz,
 )
 from app.studio._sim_view import SimView
@@ -103,7 +103,8 @@ class Session:
         if self.profiles is not None:
             for h in (self.profiles.curvature, self.profiles.steering, self.profiles.cost):
                 h.remove()
-        prof = track.sample(0.05, vehicle.wheelbase, vehicle.max_steer_deg)
+        prof = track.sample(track.detail_spacing(), vehicle.wheelbase,
+                            vehicle.max_steer_deg)
         with self.ui.plots:
             self.profiles = Profiles(self.client.gui, prof.s, prof.curvature,
                                      goal_fraction(track.closed) * track.length_m,
@@ -149,15 +150,17 @@ class Session:
                 self._show_car(path, t)
 
     def _show_car(self, path: np.ndarray, t: float) -> None:
-        """The car footprint where the best path is at time t (its column 5)."""
+        """The car where the best path is at time t (its column 5), at the vehicle's size: its
+        footprint rectangle, or 1.4 × 0.7 wheelbases when it plans as a disc."""
         k = int(np.searchsorted(path[:, 5], t).clip(0, len(path) - 1))
         x, y, th = path[k, :3]
         if self._car is None:
-            size = self.marker() * 4
-            ring = car_outline(size, 0.5 * size)
-            self._car = self.scene.add_line_segments(
-                "/live/car", polyline_segments(ring, Z["pose"], closed=True), (20, 20, 20),
-                thickness=3.0, thickness_units="screen")
+            v = self.parsed.vehicle
+            length, width = ((v.footprint.length, v.footprint.width) if v.footprint else
+                             (1.4 * v.wheelbase, 0.7 * v.wheelbase))
+            self._car = self.scene.add_frame("/live/car", show_axes=False)
+            _fill(self.scene, "/live/car/body", [car_outline(length, width)], Z["pose"],
+                 (20, 20, 20))
         self._car.position = (float(x), float(y), 0.0)
         self._car.wxyz = yaw_wxyz(float(th))
 
