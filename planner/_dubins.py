@@ -21,8 +21,15 @@ _WORDS = np.array(
 
 @njit(cache=True, inline="always")
 def _mod2pi(a: float) -> float:
-    r = a % _TWO_PI
-    return 0.0 if r > _TWO_PI - 1e-12 else r
+    """Wrap to [0, 2π). Branches for the common |a| < 2π: Python's floored ``%`` costs about
+    eight times as much, and a Dubins length takes up to 14 of these."""
+    if a < 0.0:
+        a += _TWO_PI
+        if a < 0.0:
+            a -= _TWO_PI * math.floor(a / _TWO_PI)
+    elif a >= _TWO_PI:
+        a -= _TWO_PI * math.floor(a / _TWO_PI)
+    return 0.0 if a > _TWO_PI - 1e-12 or a < 0.0 else a
 
 
 _ZERO = -1e-9  # tolerate rounding in exactly tangent cases (a pure arc: the straight is 0)
@@ -42,56 +49,79 @@ def _keep(best, i, t, p, q):
 
 
 @njit(cache=True)
-def _shortest_word(x0, y0, th0, x1, y1, th1, rho, bound):
+def _shortest_word(dx, dy, c0, s0, c1, s1, bound):
     """(word index, t, p, q) of the shortest word, lengths normalised by ρ. No allocation.
 
-    Words that cannot beat ``bound`` (normalised) are skipped as soon as that is known: the
-    middle segment p of a CSC word costs one square root, its outer arcs two atan2 more, and a
-    CCC word is never shorter than π. The result is index -1 when nothing beats the bound.
+    (dx, dy) is the goal position relative to the start, divided by ρ; (c0, s0) and (c1, s1)
+    are the cosines and sines of the start and goal headings, so a caller that keeps them per
+    node pays no trigonometry here. Words that cannot beat ``bound`` (normalised) are skipped
+    as soon as that is known: the middle segment p of a CSC word costs one square root, then
+    lower bounds of its two arcs from their cosines and sines (`_arc_bound`) a few
+    multiplications; the atan2 calls come only for words that can still beat the bound. A CCC
+    word is never shorter than π. The result is index -1 when nothing beats the bound.
     """
-    dx = (x1 - x0) / rho
-    dy = (y1 - y0) / rho
-    d = math.hypot(dx, dy)
-    theta = math.atan2(dy, dx) if d > 1e-12 else 0.0
-    a = _mod2pi(th0 - theta)
-    b = _mod2pi(th1 - theta)
-    sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
+    d = math.sqrt(dx * dx + dy * dy)
+    ct, st = (dx / d, dy / d) if d > 1e-12 else (1.0, 0.0)
+    ca, sa = c0 * ct + s0 * st, s0 * ct - c0 * st  # α = θ0 − atan2(dy, dx)
+    cb, sb = c1 * ct + s1 * st, s1 * ct - c1 * st  # β = θ1 − atan2(dy, dx)
     cab = ca * cb + sa * sb
+    a = b = -1.0  # not computed yet
     best = (-1, bound, 0.0, 0.0)
-    # LSL
-    tmp = 2.0 + d * d - 2.0 * cab + 2.0 * d * (sa - sb)
-    if tmp >= _ZERO and _sqrt0(tmp) < best[1] + best[2] + best[3]:
+    # CSC words: tmp is p² written as a sum of squares (minus 4), which keeps short straight
+    # paths exact to rounding where the textbook 2 + d² − 2 cos(α − β) + ... cancels.
+    # LSL: t = θ − α, q = β − θ with θ the direction of (d + sa − sb, cb − ca), of norm p
+    tmp = (d + sa - sb) ** 2 + (cb - ca) ** 2
+    p = _sqrt0(tmp)
+    if tmp >= _ZERO and p < best[1] + best[2] + best[3] and (p == 0.0 or p + _arcs_bound(
+            (d + sa - sb) / p, (cb - ca) / p, ca, sa, cb, sb, -1.0, 1.0)
+            < best[1] + best[2] + best[3]):
+        a, b = _angles(a, b, ca, sa, cb, sb)
         th = math.atan2(cb - ca, d + sa - sb)
         best = _keep(best, 0, _mod2pi(-a + th), _sqrt0(tmp), _mod2pi(b - th))
-    # RSR
-    tmp = 2.0 + d * d - 2.0 * cab + 2.0 * d * (sb - sa)
-    if tmp >= _ZERO and _sqrt0(tmp) < best[1] + best[2] + best[3]:
+    # RSR: t = α − θ, q = θ − β with θ the direction of (d − sa + sb, ca − cb)
+    tmp = (d - sa + sb) ** 2 + (ca - cb) ** 2
+    p = _sqrt0(tmp)
+    if tmp >= _ZERO and p < best[1] + best[2] + best[3] and (p == 0.0 or p + _arcs_bound(
+            (d - sa + sb) / p, (ca - cb) / p, ca, sa, cb, sb, 1.0, -1.0)
+            < best[1] + best[2] + best[3]):
+        a, b = _angles(a, b, ca, sa, cb, sb)
         th = math.atan2(ca - cb, d - sa + sb)
         best = _keep(best, 1, _mod2pi(a - th), _sqrt0(tmp), _mod2pi(-b + th))
-    # RSL
-    tmp = d * d - 2.0 + 2.0 * cab - 2.0 * d * (sa + sb)
-    if tmp >= _ZERO and _sqrt0(tmp) < best[1] + best[2] + best[3]:
-        p = _sqrt0(tmp)
+    # RSL: t = α − θ, q = β − θ with θ = angle(d − sa − sb, ca + cb) − angle(p, 2); both
+    # vectors have the norm √(p² + 4)
+    tmp = (d - sa - sb) ** 2 + (ca + cb) ** 2 - 4.0
+    p = _sqrt0(tmp)
+    n2 = p * p + 4.0
+    if tmp >= _ZERO and p < best[1] + best[2] + best[3] and p + _arcs_bound(
+            ((d - sa - sb) * p + (ca + cb) * 2.0) / n2, ((ca + cb) * p - (d - sa - sb) * 2.0) / n2,
+            ca, sa, cb, sb, 1.0, 1.0) < best[1] + best[2] + best[3]:
+        a, b = _angles(a, b, ca, sa, cb, sb)
         th = math.atan2(ca + cb, d - sa - sb) - math.atan2(2.0, p)
         best = _keep(best, 2, _mod2pi(a - th), p, _mod2pi(b - th))
-    # LSR
-    tmp = -2.0 + d * d + 2.0 * cab + 2.0 * d * (sa + sb)
-    if tmp >= _ZERO and _sqrt0(tmp) < best[1] + best[2] + best[3]:
-        p = _sqrt0(tmp)
+    # LSR: t = θ − α, q = θ − β with θ = angle(d + sa + sb, −ca − cb) − angle(p, −2)
+    tmp = (d + sa + sb) ** 2 + (ca + cb) ** 2 - 4.0
+    p = _sqrt0(tmp)
+    n2 = p * p + 4.0
+    if tmp >= _ZERO and p < best[1] + best[2] + best[3] and p + _arcs_bound(
+            ((d + sa + sb) * p + (ca + cb) * 2.0) / n2, (-(ca + cb) * p + (d + sa + sb) * 2.0) / n2,
+            ca, sa, cb, sb, -1.0, -1.0) < best[1] + best[2] + best[3]:
+        a, b = _angles(a, b, ca, sa, cb, sb)
         th = math.atan2(-ca - cb, d + sa + sb) - math.atan2(-2.0, p)
         best = _keep(best, 3, _mod2pi(-a + th), p, _mod2pi(-b + th))
     if best[1] + best[2] + best[3] <= math.pi:
         return best  # CCC words are never shorter than π
     # RLR
     tmp = 0.125 * (6.0 - d * d + 2.0 * cab + 2.0 * d * (sa - sb))
-    if abs(tmp) <= 1.0:
+    if abs(tmp) <= 1.0 and _ccc_middle_bound(tmp) < best[1] + best[2] + best[3]:
+        a, b = _angles(a, b, ca, sa, cb, sb)
         p = _TWO_PI - math.acos(tmp)
         th = math.atan2(ca - cb, d - sa + sb)
         t = _mod2pi(a - th + 0.5 * p)
         best = _keep(best, 4, t, p, _mod2pi(a - b - t + p))
     # LRL
     tmp = 0.125 * (6.0 - d * d + 2.0 * cab + 2.0 * d * (-sa + sb))
-    if abs(tmp) <= 1.0:
+    if abs(tmp) <= 1.0 and _ccc_middle_bound(tmp) < best[1] + best[2] + best[3]:
+        a, b = _angles(a, b, ca, sa, cb, sb)
         p = _TWO_PI - math.acos(tmp)
         th = math.atan2(-ca + cb, d + sa - sb)
         t = _mod2pi(-a + th + 0.5 * p)
@@ -99,10 +129,46 @@ def _shortest_word(x0, y0, th0, x1, y1, th1, rho, bound):
     return best
 
 
+@njit(cache=True, inline="always")
+def _arc_bound(c, s) -> float:
+    """A lower bound of the angle φ in [0, 2π) with cos φ = c and sin φ = s, without atan2: in
+    each quadrant φ exceeds the quadrant's start by at least the sine of the excess. Angles
+    within 1e-9 of 0 or 2π count as 0, as `_mod2pi` rounds them."""
+    if s >= -1e-9:
+        return max(s, 0.0) if c >= 0.0 else 0.5 * math.pi - c
+    return math.pi - s if c < 0.0 else 1.5 * math.pi + c
+
+
+@njit(cache=True, inline="always")
+def _arcs_bound(ct, st, ca, sa, cb, sb, sign_t, sign_q) -> float:
+    """Lower bound of t + q for a CSC word with middle direction θ = (ct, st): t = sign_t·(α − θ)
+    and q = sign_q·(β − θ), taken mod 2π."""
+    c_t, s_t = ca * ct + sa * st, sign_t * (sa * ct - ca * st)
+    c_q, s_q = cb * ct + sb * st, sign_q * (sb * ct - cb * st)
+    return _arc_bound(c_t, s_t) + _arc_bound(c_q, s_q)
+
+
+@njit(cache=True, inline="always")
+def _ccc_middle_bound(x) -> float:
+    """A lower bound of a CCC word's middle arc 2π − acos(x) without the acos: acos(x) ≤ π/2 − x
+    for x ≥ 0 and ≤ π/2 + (π/2)|x| for x < 0 (asin is convex on [0, 1])."""
+    return 1.5 * math.pi + x if x >= 0.0 else 1.5 * math.pi + 0.5 * math.pi * x
+
+
+@njit(cache=True, inline="always")
+def _angles(a, b, ca, sa, cb, sb):
+    """α and β in [0, 2π) from their cosines and sines, once (negative means "not yet")."""
+    if a < 0.0:
+        a = _mod2pi(math.atan2(sa, ca))
+        b = _mod2pi(math.atan2(sb, cb))
+    return a, b
+
+
 @njit(cache=True)
 def dubins_path(x0, y0, th0, x1, y1, th1, rho, kinds_out, lens_out) -> float:
     """Shortest Dubins path from pose 0 to pose 1; fills kinds_out/lens_out, returns its length."""
-    i, t, p, q = _shortest_word(x0, y0, th0, x1, y1, th1, rho, math.inf)
+    i, t, p, q = _shortest_word((x1 - x0) / rho, (y1 - y0) / rho, math.cos(th0),
+                                math.sin(th0), math.cos(th1), math.sin(th1), math.inf)
     kinds_out[:] = 0
     lens_out[:] = 0.0
     kinds_out[0] = _WORDS[i, 0]
@@ -117,28 +183,13 @@ def dubins_path(x0, y0, th0, x1, y1, th1, rho, kinds_out, lens_out) -> float:
 @njit(cache=True)
 def dubins_length(x0, y0, th0, x1, y1, th1, rho, bound) -> float:
     """Length of the shortest Dubins path, or ``bound`` itself as soon as no word can beat it."""
-    i, t, p, q = _shortest_word(x0, y0, th0, x1, y1, th1, rho, bound / rho)
-    return bound if i < 0 else (t + p + q) * rho
+    return dubins_length_cs(x0, y0, math.cos(th0), math.sin(th0), x1, y1, math.cos(th1),
+                            math.sin(th1), rho, bound)
 
 
 @njit(cache=True, inline="always")
-def dubins_to_point(x, y, th, px, py, rho) -> float:
-    """Shortest forward path from a pose to a *point* (any final heading): a lower bound of
-    every Dubins length to a pose at that point.
-
-    Outside both turning circles the optimum is CS, turning towards the point's side first
-    (Bui, Souères, Boissonnat & Laumond 1994); inside one we fall back to the straight line.
-    """
-    c, s = math.cos(th), math.sin(th)
-    dx, dy = px - x, py - y
-    u = c * dx + s * dy
-    v = abs(-s * dx + c * dy)  # mirror to the left side
-    dc = math.hypot(u, v - rho)
-    if dc < rho or math.hypot(u, v) < 1e-9:
-        # Inside a turning circle, or (nearly) at the point already, where the exact Dubins
-        # code counts it as reached: the straight line is the bound.
-        return math.hypot(u, v)
-    phi = _mod2pi(math.atan2(v - rho, u) + 0.5 * math.pi - math.acos(min(rho / dc, 1.0)))
-    if phi > 2.0 * math.pi - 1e-7:
-        phi = 0.0  # rounding of "straight ahead": a smaller bound is always a valid one
-    return rho * phi + math.sqrt(dc * dc - rho * rho)
+def dubins_length_cs(x0, y0, c0, s0, x1, y1, c1, s1, rho, bound) -> float:
+    """`dubins_length` with the headings given by their cosines and sines (kept per tree node,
+    they make a pruned length cost a few multiplications and square roots)."""
+    i, t, p, q = _shortest_word((x1 - x0) / rho, (y1 - y0) / rho, c0, s0, c1, s1, bound / rho)
+    return bound if i < 0 else (t + p + q) * rho

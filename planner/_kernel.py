@@ -21,10 +21,11 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from planner._dubins import dubins_to_point
+from planner._dubins import dubins_length_cs
 from planner._paths import path_end, truncate, wrap_angle
 from planner._rng import uniform
-from planner._steer import steer_length, steer_path
+from planner._reeds_shepp import reeds_shepp_length
+from planner._steer import steer_path
 from planner._world import World, motion_free, static_clearance_estimate
 
 # Parameter vector indices.
@@ -40,6 +41,7 @@ EV_ITER, EV_XR, EV_YR, EV_THR, EV_NEAREST, EV_NEW, EV_PARENT, EV_NEAR_START, EV_
 
 class Tree(NamedTuple):
     pose: np.ndarray  # (cap, 3)
+    trig: np.ndarray  # (cap, 2): cos θ, sin θ (Dubins lengths then need no trigonometry)
     cost: np.ndarray  # (cap,) driven length from the root
     parent: np.ndarray  # (cap,) int64, -1 for the root
     kinds: np.ndarray  # (cap, 5) int8: the edge from the parent
@@ -70,7 +72,7 @@ class Events(NamedTuple):
 def new_tree(capacity: int, grid: np.ndarray, rng: np.ndarray) -> Tree:
     nx, ny = int(grid[3]), int(grid[4])
     return Tree(
-        pose=np.zeros((capacity, 3)), cost=np.zeros(capacity),
+        pose=np.zeros((capacity, 3)), trig=np.zeros((capacity, 2)), cost=np.zeros(capacity),
         parent=np.full(capacity, -1, np.int64), kinds=np.zeros((capacity, 5), np.int8),
         lens=np.zeros((capacity, 5)), first_child=np.full(capacity, -1, np.int64),
         next_sibling=np.full(capacity, -1, np.int64), cell_head=np.full(nx * ny, -1, np.int64),
@@ -88,7 +90,7 @@ def grown(tree: Tree, capacity: int) -> Tree:
         return out
 
     return tree._replace(
-        pose=pad(tree.pose, 0.0), cost=pad(tree.cost, 0.0), parent=pad(tree.parent, -1),
+        pose=pad(tree.pose, 0.0), trig=pad(tree.trig, 0.0), cost=pad(tree.cost, 0.0), parent=pad(tree.parent, -1),
         kinds=pad(tree.kinds, 0), lens=pad(tree.lens, 0.0),
         first_child=pad(tree.first_child, -1), next_sibling=pad(tree.next_sibling, -1),
         cell_next=pad(tree.cell_next, -1), goal_nodes=pad(tree.goal_nodes, 0),
@@ -111,6 +113,8 @@ def add_node(tree: Tree, P: np.ndarray, x, y, th, cost, parent, kinds, lens) -> 
     tree.pose[k, 0] = x
     tree.pose[k, 1] = y
     tree.pose[k, 2] = th
+    tree.trig[k, 0] = math.cos(th)
+    tree.trig[k, 1] = math.sin(th)
     tree.cost[k] = cost
     tree.parent[k] = parent
     tree.kinds[k, :] = kinds
@@ -185,19 +189,27 @@ def _cheap_bound(x0, y0, th0, x1, y1, th1, rho) -> float:
 
 
 @njit(cache=True, inline="always")
-def _tight_bound(x0, y0, th0, x1, y1, th1, rho) -> float:
-    """A tighter lower bound for forward-only (Dubins) paths: the shortest path to the second
-    pose's position (any heading), and backwards from the second pose to the first position."""
-    a = dubins_to_point(x0, y0, th0, x1, y1, rho)
-    return max(a, dubins_to_point(x1, y1, th1 + math.pi, x0, y0, rho))
+def _length_to(tree: Tree, P, j, x, y, th, c, s, bound) -> float:
+    """Steering length from node j to the pose (x, y, th) whose cos and sin are c, s; any
+    value ≥ ``bound`` once it cannot beat it. A Dubins length that cannot beat its bound costs
+    about as much as the cheap lower bounds would, so there is no bound tighter than
+    `_cheap_bound` in between."""
+    if P[REVERSE] > 0.0:
+        return reeds_shepp_length(tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], x, y, th,
+                                  P[RHO], bound)
+    return dubins_length_cs(tree.pose[j, 0], tree.pose[j, 1], tree.trig[j, 0], tree.trig[j, 1],
+                            x, y, c, s, P[RHO], bound)
 
 
 @njit(cache=True, inline="always")
-def _can_beat(P, x0, y0, th0, x1, y1, th1, bound) -> bool:
-    """False when a bound already proves the path from pose 0 to pose 1 is ≥ ``bound``."""
-    if _cheap_bound(x0, y0, th0, x1, y1, th1, P[RHO]) >= bound:
-        return False
-    return P[REVERSE] > 0.0 or _tight_bound(x0, y0, th0, x1, y1, th1, P[RHO]) < bound
+def _length_from(tree: Tree, P, x, y, th, c, s, j, bound) -> float:
+    """Steering length from the pose (x, y, th) (cos and sin c, s) to node j; see
+    `_length_to`."""
+    if P[REVERSE] > 0.0:
+        return reeds_shepp_length(x, y, th, tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2],
+                                  P[RHO], bound)
+    return dubins_length_cs(x, y, c, s, tree.pose[j, 0], tree.pose[j, 1], tree.trig[j, 0],
+                            tree.trig[j, 1], P[RHO], bound)
 
 
 @njit(cache=True, inline="always")
@@ -245,6 +257,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
     the first ones are usually near-optimal and the search stops when neither the heap's top
     nor the next ring's distance can beat the best length found.
     """
+    qc, qs = math.cos(qth), math.sin(qth)
     nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
     ci, cj = _cell(tree, qx, qy)
     cells = np.empty(8 * (max(nx, ny) + 1), np.int64)
@@ -253,7 +266,6 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
     best, besti = math.inf, -1
     k = 0
     last_ring = max(nx, ny)
-    tighten = P[REVERSE] == 0.0
     while True:
         ring_bound = max(0.0, (k - 1) * cell) if k <= last_ring else math.inf
         if size > 0 and keys[0] <= ring_bound:
@@ -261,17 +273,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             if key >= best:
                 break  # every remaining candidate, opened or not, is at least this far
             size = _heap_pop(keys, vals, size)
-            if node >= 0 and tighten:
-                # First time at the top: tighten the bound and queue it again (-1 - node
-                # marks "tightened"); only few nodes ever get here.
-                tight = _tight_bound(tree.pose[node, 0], tree.pose[node, 1],
-                                     tree.pose[node, 2], qx, qy, qth, P[RHO])
-                if tight < best:
-                    size = _heap_push(keys, vals, size, max(tight, key), -1 - node)
-                continue
-            node = node if node >= 0 else -1 - node
-            d = steer_length(P[REVERSE], tree.pose[node, 0], tree.pose[node, 1],
-                             tree.pose[node, 2], qx, qy, qth, P[RHO], best)
+            d = _length_to(tree, P, node, qx, qy, qth, qc, qs, best)
             if d < best:
                 best, besti = d, node
         elif ring_bound >= best:
@@ -439,6 +441,7 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
     leaves the winning edge in kinds/lens.
     """
     keys, vals = tree.near_key, tree.stack
+    c, s = math.cos(th), math.sin(th)
     size = 0
     for q in range(m):
         j = tree.near[q]
@@ -454,9 +457,7 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
         px, py, pth = tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2]
         if v >= 0:
             bound = min(radius, c_new - tree.cost[j])
-            if P[REVERSE] == 0.0 and _tight_bound(px, py, pth, x, y, th, P[RHO]) >= bound:
-                continue
-            d = steer_length(P[REVERSE], px, py, pth, x, y, th, P[RHO], bound)
+            d = _length_to(tree, P, j, x, y, th, c, s, bound)
             if d < bound:
                 size = _heap_push(keys, vals, size, tree.cost[j] + d, -1 - j)
             continue
@@ -555,16 +556,16 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
                     ev.cnt[1] += 1
             ev.rows[row, EV_NEAR_END] = ev.cnt[1]
         # Rewire: near nodes that are cheaper to reach through the new node.
+        c, s = tree.trig[new, 0], tree.trig[new, 1]
         for q in range(m):
             j = tree.near[q]
             if j == parent:
                 continue
             budget = min(tree.cost[j] - c_new, radius)
-            if tree.near_len[q] >= budget - 1e-9 or not _can_beat(
-                    P, x, y, th, tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], budget):
+            lb = max(tree.near_len[q], P[RHO] * abs(wrap_angle(tree.pose[j, 2] - th)))
+            if lb >= budget - 1e-9:
                 continue  # not even the lower bound could make j cheaper
-            l = steer_length(P[REVERSE], x, y, th, tree.pose[j, 0], tree.pose[j, 1],
-                             tree.pose[j, 2], P[RHO], budget)
+            l = _length_from(tree, P, x, y, th, c, s, j, budget)
             if l >= budget - 1e-9:
                 continue
             steer_path(P[REVERSE], x, y, th, tree.pose[j, 0], tree.pose[j, 1],

@@ -127,5 +127,7 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
 
 @njit(cache=True, inline="always")
 def wrap_angle(a: float) -> float:
-    """Wrap to [-π, π)."""
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
+    """Wrap to [-π, π) (without the slow floored ``%`` in the common case)."""
+    if -math.pi <= a < math.pi:
+        return a
+    return a - 2.0 * math.pi * math.floor((a + math.pi) / (2.0 * math.pi))

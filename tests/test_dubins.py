@@ -7,7 +7,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from planner._dubins import dubins_length, dubins_path, dubins_to_point
+from planner._dubins import dubins_length, dubins_path
 from planner._paths import path_end, path_length, sample_path
 
 RHO = 0.44 / math.tan(math.radians(26))
@@ -79,29 +79,6 @@ def test_bounded_length_never_underestimates(q0, q1, bound):
         assert bounded == pytest.approx(exact, abs=1e-12)
     else:
         assert bounded >= bound - 1e-12
-
-
-@settings(max_examples=300, deadline=None)
-@given(pose, pose)
-def test_to_point_is_a_lower_bound(q0, q1):
-    # 1e-8 m: the Dubins formulas cancel 2 + d² - 2cos(α - β), losing straights under ~10 nm.
-    exact = dubins_length(*q0, *q1, RHO, math.inf)
-    assert dubins_to_point(*q0, q1[0], q1[1], RHO) <= exact + 1e-8
-    back = dubins_to_point(q1[0], q1[1], q1[2] + math.pi, q0[0], q0[1], RHO)
-    assert back <= exact + 1e-8
-
-
-def test_to_point_matches_the_minimum_over_final_headings():
-    """Independent check: the to-point length is the min over all final headings."""
-    rng = np.random.default_rng(3)
-    for _ in range(30):
-        q0 = (0.0, 0.0, 0.0)
-        px, py = rng.uniform(-4, 4, 2)
-        if min(math.hypot(px, py - RHO), math.hypot(px, py + RHO)) < RHO:
-            continue  # inside a turning circle the bound is only the straight line
-        best = min(dubins_length(*q0, px, py, th, RHO, math.inf)
-                   for th in np.linspace(-math.pi, math.pi, 3601))
-        assert dubins_to_point(*q0, px, py, RHO) == pytest.approx(best, abs=2e-3)
 
 
 @settings(max_examples=100, deadline=None)
