@@ -108,7 +108,7 @@ def test_laps_are_counted_and_timed_on_the_thesis_track(tmp_path):
     _, log = _read_log(log_path)
     sweeps = np.abs(_sweeps(log))
     assert sweeps[-1] == pytest.approx(laps, abs=0.02)  # ends as it comes round the last time
-    first = int(round(s["lap_times_s"][0] * 100))
+    first = round(s["lap_times_s"][0] * 100)
     assert sweeps[first] == pytest.approx(1.0, abs=0.02)
     assert s["collisions"] == 0
 

@@ -13,8 +13,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
 
-from app.server import (routes_jobs, routes_plan, routes_scenarios, routes_simulations,
-                        routes_tracks)
+from app.server import routes_jobs, routes_plan, routes_scenarios, routes_simulations, routes_tracks
 from app.server.jobs import Planning
 from app.server.models import Health
 from app.server.store import Store

@@ -5,8 +5,10 @@ from __future__ import annotations
 from fastapi import APIRouter, HTTPException, Request
 from fastapi.responses import FileResponse
 
+import planner
 from app.server.models import SimulationCreated, SimulationRequest, SimulationStatus
 from app.server.routes_scenarios import resolve
+from planner.sim.laps import require_track
 
 router = APIRouter(tags=["simulations"])
 
@@ -18,13 +20,11 @@ async def create_simulation(request: Request, body: SimulationRequest) -> Simula
     GET /simulations/{id} for progress and the summary, then GET /simulations/{id}/log."""
     scenario, track = resolve(request, body.scenario_id or body.scenario)
     options = body.options()
-    try:
-        options.settings()
-    except ValueError as exc:
-        raise HTTPException(422, str(exc)) from None
-    if options.laps is not None and scenario.get("track") is None:
-        raise HTTPException(422, "laps needs a scenario with a closed track "
-                                 "(rich schema, e.g. \"track\": {\"name\": \"thesis\"})")
+    if options.laps is not None:
+        try:
+            require_track(planner.parse_scenario(scenario))
+        except ValueError as exc:
+            raise HTTPException(422, str(exc).removeprefix("--")) from None
     await request.app.state.planning.check(scenario, track)
     sim_id = request.app.state.planning.start_simulation(scenario, options, track)
     return SimulationCreated(id=sim_id)

@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-__all__ = ["LapCounter"]
+__all__ = ["LapCounter", "require_track"]
 
 SPACING = 0.05  # m between centreline samples
 WINDOW = 1.0  # m of arc searched either side of the last projection (tracks pass near themselves)
@@ -24,6 +24,13 @@ FURTHER = (0.0, 0.5, 1.0)
 BESIDE = (0.0, 1 / 3, -1 / 3, 2 / 3, -2 / 3)
 
 
+def require_track(scenario) -> None:
+    """Lap mode needs a track to lap: say so in one line otherwise."""
+    if scenario.track is None:
+        raise ValueError("--laps needs a scenario with a closed track "
+                         "(rich schema, e.g. \"track\": {\"name\": \"thesis\"})")
+
+
 class LapCounter:
     """Progress along a closed centreline, completed laps with their times, the rolling goal."""
 
@@ -31,10 +38,9 @@ class LapCounter:
         if not track.closed:
             raise ValueError(f"--laps needs a closed track, '{track.name}' is open")
         prof = track.sample(spacing=SPACING)
-        keep = slice(0, -1) if math.hypot(prof.x[-1] - prof.x[0], prof.y[-1] - prof.y[0]) < 1e-9 \
-            else slice(None)  # the closing sample repeats the first
-        self.x, self.y = prof.x[keep], prof.y[keep]
-        self.heading, self.s = prof.heading[keep], prof.s[keep]
+        # A closed profile ends where it starts, at s = length: drop that repeat.
+        self.x, self.y = prof.x[:-1], prof.y[:-1]
+        self.heading, self.s = prof.heading[:-1], prof.s[:-1]
         self.length = float(prof.s[-1])
         self.ahead = ahead
         self.half_width = track.width_m / 2.0

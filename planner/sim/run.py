@@ -23,7 +23,7 @@ from planner.scenario import Scenario
 from planner.sim.control import CONTROLLERS, Reference, Tracking, steer_command
 from planner.sim.fsm import Machine
 from planner.sim.fsm.runtime import Behaviour
-from planner.sim.laps import LapCounter
+from planner.sim.laps import LapCounter, require_track
 from planner.sim.metrics import collision_runs, cycle_stats
 from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
@@ -121,9 +121,7 @@ def _lap_counter(scenario: Scenario, problem: Problem, s: SimSettings, load_trac
     plan for N laps: the cycles go on extending the path, but on the t = 0 sensing alone."""
     if s.laps is None:
         return None
-    if scenario.track is None:
-        raise ValueError("--laps needs a scenario with a closed track "
-                         "(rich schema, e.g. \"track\": {\"name\": \"thesis\"})")
+    require_track(scenario)
     return LapCounter(resolve_track(scenario, load_track), problem.start, s.goal_ahead)
 
 
@@ -139,6 +137,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     """
     s = settings or SimSettings()
     problem = problem or compile_problem(scenario)
+    counter = _lap_counter(scenario, problem, s, load_track)  # before the slow warm-up
     warm_up()
     warm_up_replanning()
     vehicle = scenario.vehicle
@@ -157,7 +156,6 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     replanner = new_replanner()
     fsm = Behaviour(behaviour, problem.world, limits.wheelbase, dt) if behaviour else None
     gains = Tracking()
-    counter = _lap_counter(scenario, problem, s, load_track)
     # Heading noise as if θ came from two position fixes a wheelbase apart.
     pose_sigma = (s.noise, s.noise, math.sqrt(2.0) * s.noise / limits.wheelbase)
     cruise = vehicle.speed if fsm is None else limits.max_speed  # FollowTrack caps its own
