@@ -134,9 +134,9 @@ def _add_obstacle(s, kind: str) -> None:
     x, y, heading = float(prof.x[i]), float(prof.y[i]), float(prof.heading[i])
     size = 0.3 * track.width_m
     if kind == "circle":
-        ob = {"type": "circle", "center": [x, y], "radius": round(size, 3)}
+        ob = {"type": "circle", "center": [x, y], "radius": round(size, 5)}
     else:
-        ob = {"type": "box", "center": [x, y], "size": [round(2 * size, 3), round(size, 3)],
+        ob = {"type": "box", "center": [x, y], "size": [round(2 * size, 5), round(size, 5)],
               "angle_deg": round(math.degrees(heading), 1)}
     add_obstacle(s, ob)
 

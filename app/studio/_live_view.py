@@ -21,6 +21,10 @@ PATH_RGB = (255, 90, 200)
 OLD_RGB, NEW_RGB = (255, 60, 60), (80, 255, 120)
 REWIRED_PER_SLOW_TICK = 4
 SLOW_EVERY = 5  # ticks
+# Rewire flashes (up to 96 edges, 0.6 s each) change every tick while RRT* rewires: re-sent every
+# other tick with every other point of the edge, a quarter of the bytes of a full redraw.
+FLASH_EVERY = 2  # ticks
+FLASH_STRIDE = 2
 
 
 def _circle(x: float, y: float, r: float, z: float, n: int = 40) -> np.ndarray:
@@ -74,7 +78,8 @@ class LiveView:
             else:
                 h.points = seg
             self.sent_chunks += 1
-        self._flashes()
+        if self._ticks % FLASH_EVERY == 0:
+            self._flashes()
         if self.live.best_version != self._seen["best"]:
             self._seen["best"] = self.live.best_version
             path = self.live.best_path
@@ -88,8 +93,8 @@ class LiveView:
         fl = [f for f in list(self.live.flashes) if now - f[0] < FLASH_S]
         if not fl and "flash_old" not in self._handles:
             return
-        self._put("flash_old", _edges([f[1] for f in fl], Z["flash"]), OLD_RGB, 2.5)
-        self._put("flash_new", _edges([f[2] for f in fl], Z["flash"]), NEW_RGB, 2.5)
+        self._put("flash_old", _edges([f[1][::FLASH_STRIDE] for f in fl], Z["flash"]), OLD_RGB, 2.5)
+        self._put("flash_new", _edges([f[2][::FLASH_STRIDE] for f in fl], Z["flash"]), NEW_RGB, 2.5)
 
     def _step_overlay(self, st: dict | None) -> None:
         """x_rand, x_nearest, x_new, the near radius and nodes, the chosen parent edge."""
