@@ -177,13 +177,12 @@ def _draw_draft_lines(s) -> None:
     bars = [polyline_segments(np.array([p - h, p + h]), Z["pose"])
             for p, h in ((d.points[i], d.handle(i, closed)) for i in range(len(d.points)))]
     empty = np.zeros((0, 2, 3), np.float32)
-    with s.client.atomic():
-        s.scene.add_line_segments("/draft/line", np.concatenate(curves) if curves else empty,
-                                  DRAFT_RGB, thickness=2.0, thickness_units="screen",
-                                  visible=bool(curves))
-        s.scene.add_line_segments("/draft/bars", np.concatenate(bars) if bars else empty,
-                                  (255, 200, 120), thickness=1.0, thickness_units="screen",
-                                  visible=bool(bars))
+    s.scene.add_line_segments("/draft/line", np.concatenate(curves) if curves else empty,
+                              DRAFT_RGB, thickness=2.0, thickness_units="screen",
+                              visible=bool(curves))
+    s.scene.add_line_segments("/draft/bars", np.concatenate(bars) if bars else empty,
+                              (255, 200, 120), thickness=1.0, thickness_units="screen",
+                              visible=bool(bars))
 
 
 def _move_anchor(s, i: int, x: float, y: float) -> None:

@@ -19,7 +19,8 @@ __all__ = ["Z", "add_grid", "car_outline", "curvature_colors", "draw_obstacles",
            "obstacle_shape",
            "offset_at", "polyline_segments", "wxyz_yaw", "yaw_wxyz"]
 
-Z = {"surface": -0.02, "centre": 0.002, "obstacle": 0.004, "tree": 0.006, "flash": 0.008,
+# Obstacles above the tree: edges pass where a moving obstacle is at other times.
+Z = {"surface": -0.02, "centre": 0.002, "tree": 0.006, "flash": 0.008, "obstacle": 0.009,
      "path": 0.01, "step": 0.012, "pose": 0.014}
 
 
