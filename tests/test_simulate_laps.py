@@ -28,7 +28,7 @@ THESIS = tracks.load_library_track("thesis")
 CENTRE = (2.366, -2.297)  # inside the thesis loop: the middle of its bounding box
 
 
-def _cli(*args, timeout=300):
+def _cli(*args, timeout=900):  # generous: a loaded 2-core runner, cold kernel caches
     return subprocess.run(["trackstar", "simulate", *map(str, args)], check=False,
                           capture_output=True, text=True, timeout=timeout)
 
