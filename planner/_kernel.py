@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from planner._dubins import dubins_length_cs
+from planner._dubins import dubins_length_cs, dubins_lower_bound_cs
 from planner._paths import path_end, truncate, wrap_angle
 from planner._rng import uniform
 from planner._reeds_shepp import reeds_shepp_length
@@ -189,6 +189,25 @@ def _cheap_bound(x0, y0, th0, x1, y1, th1, rho) -> float:
 
 
 @njit(cache=True, inline="always")
+def _bound_to(tree: Tree, P, j, x, y, th, c, s) -> float:
+    """A cheap lower bound of the steering length from node j to the pose (x, y, th) with
+    cos and sin c, s: the forward-path bound for Dubins, `_cheap_bound` with reversing."""
+    if P[REVERSE] > 0.0:
+        return _cheap_bound(tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], x, y, th, P[RHO])
+    return dubins_lower_bound_cs(tree.pose[j, 0], tree.pose[j, 1], tree.trig[j, 0],
+                                 tree.trig[j, 1], x, y, c, s, P[RHO])
+
+
+@njit(cache=True, inline="always")
+def _bound_from(tree: Tree, P, x, y, th, c, s, j) -> float:
+    """`_bound_to` the other way: from the pose to node j."""
+    if P[REVERSE] > 0.0:
+        return _cheap_bound(x, y, th, tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], P[RHO])
+    return dubins_lower_bound_cs(x, y, c, s, tree.pose[j, 0], tree.pose[j, 1], tree.trig[j, 0],
+                                 tree.trig[j, 1], P[RHO])
+
+
+@njit(cache=True, inline="always")
 def _length_to(tree: Tree, P, j, x, y, th, c, s, bound) -> float:
     """Steering length from node j to the pose (x, y, th) whose cos and sin are c, s; any
     value ≥ ``bound`` once it cannot beat it. A Dubins length that cannot beat its bound costs
@@ -282,8 +301,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             for q in range(_ring_cells(tree, ci, cj, k, cells)):
                 node = tree.cell_head[cells[q]]
                 while node >= 0:
-                    lb = _cheap_bound(tree.pose[node, 0], tree.pose[node, 1],
-                                      tree.pose[node, 2], qx, qy, qth, P[RHO])
+                    lb = _bound_to(tree, P, node, qx, qy, qth, qc, qs)
                     if lb < best:
                         size = _heap_push(keys, vals, size, lb, node)
                     node = tree.cell_next[node]
@@ -447,7 +465,9 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
         j = tree.near[q]
         if j == parent:
             continue
-        lb = max(tree.near_len[q], P[RHO] * abs(wrap_angle(th - tree.pose[j, 2])))
+        if tree.near_len[q] >= radius or tree.cost[j] + tree.near_len[q] >= c_new - 1e-12:
+            continue
+        lb = _bound_to(tree, P, j, x, y, th, c, s)
         if lb < radius and tree.cost[j] + lb < c_new - 1e-12:
             size = _heap_push(keys, vals, size, tree.cost[j] + lb, j)
     while size > 0 and keys[0] < c_new - 1e-12:
@@ -562,8 +582,8 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
             if j == parent:
                 continue
             budget = min(tree.cost[j] - c_new, radius)
-            lb = max(tree.near_len[q], P[RHO] * abs(wrap_angle(tree.pose[j, 2] - th)))
-            if lb >= budget - 1e-9:
+            if tree.near_len[q] >= budget - 1e-9 or _bound_from(
+                    tree, P, x, y, th, c, s, j) >= budget - 1e-9:
                 continue  # not even the lower bound could make j cheaper
             l = _length_from(tree, P, x, y, th, c, s, j, budget)
             if l >= budget - 1e-9:

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from planner._dubins import dubins_length, dubins_path
+from planner._dubins import dubins_length, dubins_lower_bound_cs, dubins_path
 from planner._paths import path_end, path_length, sample_path
 
 RHO = 0.44 / math.tan(math.radians(26))
@@ -79,6 +79,27 @@ def test_bounded_length_never_underestimates(q0, q1, bound):
         assert bounded == pytest.approx(exact, abs=1e-12)
     else:
         assert bounded >= bound - 1e-12
+
+
+@settings(max_examples=500, deadline=None)
+@given(pose, pose, st.floats(-1e-3, 1e-3), st.floats(-1e-3, 1e-3))
+def test_cheap_lower_bound_never_exceeds_the_length(q0, q1, jx, jy):
+    # jx, jy: also nearby pairs (offsets under a millimetre), where the bound is tightest.
+    for a, b in ((q0, q1), (q0, (q0[0] + jx, q0[1] + jy, q1[2]))):
+        exact = dubins_length(*a, *b, RHO, math.inf)
+        bound = dubins_lower_bound_cs(a[0], a[1], math.cos(a[2]), math.sin(a[2]), b[0], b[1],
+                                      math.cos(b[2]), math.sin(b[2]), RHO)
+        assert bound <= exact + 1e-9
+
+
+def test_cheap_lower_bound_is_tight_behind_and_large_beside():
+    """A pose straight behind another with the same heading: the bound is the chord; beside it:
+    at least half a turn, where the chord and |Δθ| alone give nearly nothing."""
+    cos0, sin0 = 1.0, 0.0
+    assert dubins_lower_bound_cs(0, 0, cos0, sin0, 2.0, 0, cos0, sin0, RHO) == pytest.approx(2.0)
+    beside = dubins_lower_bound_cs(0, 0, cos0, sin0, 0.0, 0.1, cos0, sin0, RHO)
+    assert beside == pytest.approx(math.pi * RHO)
+    assert dubins_length(0, 0, 0, 0.0, 0.1, 0, RHO, math.inf) >= beside
 
 
 @settings(max_examples=100, deadline=None)
