@@ -543,10 +543,10 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
         c_new = tree.cost[near_i] + dist
         if not motion_free(w, nx0, ny0, nth0, tree.cost[near_i] / P[SPEED], kinds, lens,
                            P[RHO], P[SPEED], counter):
-            if P[STAR] == 0.0:
-                continue
-            # RRT*: another near node may still reach x_new (with moving obstacles often one
-            # that arrives later, when the way is clear).
+            if P[STAR] == 0.0 or not timed:
+                continue  # as in Karaman & Frazzoli's EXTEND and OMPL: x_new is dropped
+            # With moving obstacles another near node may still reach x_new: one that arrives
+            # later, when the way is clear.
             parent = -1
             c_new = math.inf
         m = 0

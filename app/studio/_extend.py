@@ -50,8 +50,7 @@ def explain(info: StepInfo, star: bool) -> tuple[int, str]:
     if info.nearest < 0:
         return 0, "x_rand fell inside an obstacle: SampleFree rejects it (the iteration counts)."
     if info.new < 0:
-        return 3, (f"The path from x_nearest (#{info.nearest}) to x_new is blocked"
-                   + (" and no near node reaches it" if star else "") + ": no node added.")
+        return 3, f"The path from x_nearest (#{info.nearest}) to x_new is blocked: no node added."
     if not star:
         return 6, f"x_new (#{info.new}) added with parent x_nearest (#{info.parent})."
     if info.n_rewired:
