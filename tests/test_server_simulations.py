@@ -61,7 +61,7 @@ def test_laps_of_a_stored_scenario_with_progress(server):
     stored = server.client.post("/scenarios", json=THESIS)
     assert stored.status_code == 201, stored.text
     created = server.client.post("/simulations", json={
-        "scenario_id": stored.json()["id"], "laps": 1, "fixed_latency_ms": 20, "seed": 2})
+        "scenario_id": stored.json()["id"], "laps": 1, "fixed_latency_ms": 100, "seed": 2})
     assert created.status_code == 202, created.text
     sim_id = created.json()["id"]
     early = server.client.get(f"/simulations/{sim_id}/log")

@@ -96,7 +96,7 @@ def test_laps_are_counted_and_timed_on_the_thesis_track(tmp_path):
     laps = 2
     log_path = tmp_path / "run.csv"
     r = _cli(_plain(tmp_path), "--laps", laps, "--seed", 3,
-             "--fixed-latency", 20, "--json", "--log", log_path)
+             "--fixed-latency", 100, "--json", "--log", log_path)
     assert r.returncode == 0, r.stderr
     s = json.loads(r.stdout)
     assert s["laps"] == laps and s["reached_goal"] and len(s["lap_times_s"]) == laps

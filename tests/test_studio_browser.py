@@ -312,6 +312,7 @@ def test_dragging_an_obstacle_moves_it_in_the_scenario(browser, ui_url):
 def test_a_polygon_clicked_on_the_ground_becomes_an_obstacle(browser, ui_url):
     page = open_tab(browser, ui_url)
     page.get_by_text("Polygon (click the ground)").click()
+    time.sleep(1.5)  # the server arms the ground click on the checkbox: a round trip
     corners = [(420, 785), (520, 780), (540, 835), (430, 845)]  # on the bottom straight
     for n, xy in enumerate(corners, 1):
         page.mouse.click(*xy)
@@ -364,6 +365,9 @@ def test_a_scenario_saved_to_the_server_loads_back_with_its_track(browser, urls,
     svg = tmp_path / "small.svg"
     svg.write_text(SMALL_SVG)
     page.locator("input[type=file]").first.set_input_files(str(svg))
+    # The new track replaces the scene (and its obstacles) first: wait until the view changed.
+    wait_until(page, lambda img: np.abs(img.astype(int) - thesis.astype(int)).mean() > 10)
+    wait_still(page)
     click(page, "Add box")
     wait_until(page, lambda img: red(img).sum() > 100 and asphalt(img) > 0.1)
     wait_still(page)
