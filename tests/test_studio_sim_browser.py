@@ -65,9 +65,10 @@ def test_simulate_plays_the_crossing_live(browser, ui_url):
     # Software WebGL on two cores lags the live run by seconds (on a loaded machine one
     # screenshot can take longer than the run): look at where the car is, not when.
     shots = []
-    while not shots or (len(shots) < 12 and "done" not in sim_status(page)):
+    while not shots or (len(shots) < 5 and "done" not in sim_status(page)):
         png = page.screenshot(path=str(sb.ARTIFACTS / f"sim_{len(shots) + 1:02d}.png"))
         shots.append(pixels(png)[:, :960])
+        time.sleep(2.0)  # a few shots spread over the ~19 s run, not a queue of them
     seen = [x for x in (car_along(img, lane) for img in shots) if x is not None]
     assert seen, "no car on the lane"
     assert seen[-1] > 0.3, seen  # it starts 5 % along the lane and drives right
