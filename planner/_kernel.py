@@ -210,9 +210,7 @@ def _bound_from(tree: Tree, P, x, y, th, c, s, j) -> float:
 @njit(cache=True, inline="always")
 def _length_to(tree: Tree, P, j, x, y, th, c, s, bound) -> float:
     """Steering length from node j to the pose (x, y, th) whose cos and sin are c, s; any
-    value ≥ ``bound`` once it cannot beat it. A Dubins length that cannot beat its bound costs
-    about as much as the cheap lower bounds would, so there is no bound tighter than
-    `_cheap_bound` in between."""
+    value ≥ ``bound`` once it cannot beat it (callers first try the cheaper `_bound_to`)."""
     if P[REVERSE] > 0.0:
         return reeds_shepp_length(tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], x, y, th,
                                   P[RHO], bound)
