@@ -172,3 +172,23 @@ def test_waypoints_text_is_rows_of_t_dx_dy():
     assert parse_waypoints("0 0 0; 3 0.5 0\n6, 1, 1") == [[0, 0, 0], [3, 0.5, 0], [6, 1, 1]]
     with pytest.raises(ValueError, match="t dx dy"):
         parse_waypoints("0 0; 1 1 1")
+
+
+def test_a_run_that_ends_between_metric_updates_still_shows_its_last_numbers():
+    """Metrics are throttled to two a second; a 300-iteration run ends well within one."""
+    import time
+
+    from app.studio._worker import PlannerWorker
+
+    worker = PlannerWorker(_problem(), planner.PlannerSettings(seed=0), budget=300)
+    try:
+        worker.run()
+        deadline = time.monotonic() + 10
+        while worker.live.state != "done" and time.monotonic() < deadline:
+            time.sleep(0.01)
+        time.sleep(0.05)
+        assert worker.live.state == "done"
+        assert worker.live.metrics["iterations"] == 300
+        assert worker.live.metrics["nodes"] == worker._run.nodes > 2
+    finally:
+        worker.stop()

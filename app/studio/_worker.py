@@ -98,6 +98,7 @@ class PlannerWorker:
                 running = not self._done()
             elif cmd == "pause":
                 running = False
+                self._publish_metrics()
             elif cmd == "step" and not self._done():
                 running = False
                 self._advance(1, stepping=True)
@@ -111,6 +112,8 @@ class PlannerWorker:
                 else:
                     time.sleep(max(0.0, n / self.rate - took))
                 running = not self._done()
+                if not running:  # a short run can end between two throttled updates
+                    self._publish_metrics()
                 time.sleep(0)  # let the UI thread take the GIL between batches
 
     def _done(self) -> bool:
@@ -176,8 +179,11 @@ class PlannerWorker:
             live.cost_over_time.append((self._wall, cost))
         if now - self._last_metrics >= 0.5 or self._stepping:
             self._last_metrics = now
-            live.metrics = self._metrics()
-            live.metrics_version += 1
+            self._publish_metrics()
+
+    def _publish_metrics(self) -> None:
+        self.live.metrics = self._metrics()
+        self.live.metrics_version += 1
 
     def _metrics(self) -> dict:
         run = self._run
