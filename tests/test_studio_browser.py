@@ -259,9 +259,15 @@ def drag(page, a, b) -> None:
 
 def show_folder(page, title: str, control: str) -> None:
     """Expand a collapsed GUI folder unless ``control`` (a button in it) is visible."""
-    if not page.get_by_role("button", name=control, exact=True).is_visible():
+    button = page.get_by_role("button", name=control, exact=True)
+    if not button.is_visible():
         page.get_by_text(title, exact=True).click()
-        page.get_by_role("button", name=control, exact=True).wait_for()
+        button.wait_for()
+        # The folder slides open: a forced click during the animation lands beside the button.
+        last, deadline = None, time.monotonic() + 5
+        while (box := button.bounding_box()) != last and time.monotonic() < deadline:
+            last = box
+            time.sleep(0.15)
 
 
 def download_scenario(page) -> dict:
