@@ -196,31 +196,36 @@ def dubins_length_cs(x0, y0, c0, s0, x1, y1, c1, s1, rho, bound) -> float:
 
 
 @njit(cache=True, inline="always")
-def _angle_bound(c, s) -> float:
-    """A lower bound of |φ| for φ in [−π, π] with cos φ = c and sin φ = s, without atan2:
-    |φ| ≥ |sin φ|, and tan(φ/2) = s / (1 + c) with atan(x) ≥ πx/4 on [0, 1] up to π/2; beyond,
-    π − |φ| ≤ (π/2)|sin φ| (sin is concave there). Exact at 0, ±π/2 and ±π."""
-    if c >= 0.0:
-        return max(abs(s), 0.5 * math.pi * abs(s) / (1.0 + c))
-    return math.pi - 0.5 * math.pi * abs(s)
+def turning_centres(x, y, c, s, rho):
+    """Centres of the left and right turning circles of the pose (x, y) with heading cos and
+    sin c, s: (left x, left y, right x, right y)."""
+    return x - rho * s, y + rho * c, x + rho * s, y - rho * c
 
 
 @njit(cache=True, inline="always")
-def dubins_lower_bound_cs(x0, y0, c0, s0, x1, y1, c1, s1, rho) -> float:
-    """A lower bound of the Dubins length in a dozen multiplications (headings by cos and sin).
+def dubins_lower_bound(l0x, l0y, r0x, r0y, l1x, l1y, r1x, r1y, turn, rho) -> float:
+    """A lower bound of the Dubins length from two square roots, given both poses' turning
+    circle centres (`turning_centres`, kept per tree node) and ``turn`` = θ1 − θ0 wrapped to
+    [−π, π].
 
-    A forward path's tangent must point along the chord somewhere (its mean direction), so
-    unless the heading sweeps π or more it turns from θ0 to the chord and on to θ1: the length
-    is at least ρ·min(|β0| + |β1|, π), with β the headings' angles to the chord, and at least
-    ρ·|θ1 − θ0| and the chord itself. Nodes beside or ahead of a pose, which the chord and
-    |Δθ| alone let through, are what this prunes. Within a micrometre (where the Dubins
-    formulas round to "already there") only the chord and |Δθ| count.
+    The centre of the car's left turning circle, p + ρ·n, moves at speed 1 − ρκ, the right
+    one's at 1 + ρκ; over a forward path of length ℓ and net turning τ they give
+    ℓ ≥ |Δc_left| + ρτ and ℓ ≥ |Δc_right| − ρτ. τ is ``turn`` + 2πk for an unknown k, so
+    the bound is the least over k, attained at one of the two k nearest the balance point.
+    It is never below the chord or ρ|Δθ|, and close to the length where the car has to turn
+    round (a pose facing back at a node), where those two let every node through.
     """
-    dx, dy = x1 - x0, y1 - y0
-    d = math.sqrt(dx * dx + dy * dy)
-    turn = _angle_bound(c0 * c1 + s0 * s1, c0 * s1 - s0 * c1)  # |θ1 − θ0|
-    if d > 1e-6:
-        b0 = _angle_bound((c0 * dx + s0 * dy) / d, (c0 * dy - s0 * dx) / d)
-        b1 = _angle_bound((c1 * dx + s1 * dy) / d, (c1 * dy - s1 * dx) / d)
-        turn = max(turn, min(b0 + b1, math.pi))
-    return max(d, rho * turn)
+    a = math.sqrt((l1x - l0x) * (l1x - l0x) + (l1y - l0y) * (l1y - l0y))
+    b = math.sqrt((r1x - r0x) * (r1x - r0x) + (r1y - r0y) * (r1y - r0y))
+    x = rho * turn
+    y = x - math.copysign(_TWO_PI * rho, turn)  # the other side of 0
+    return min(max(a + x, b - x), max(a + y, b - y))
+
+
+@njit(cache=True)
+def dubins_lower_bound_cs(x0, y0, c0, s0, x1, y1, c1, s1, turn, rho) -> float:
+    """`dubins_lower_bound` from the poses (headings by cos and sin)."""
+    l0x, l0y, r0x, r0y = turning_centres(x0, y0, c0, s0, rho)
+    l1x, l1y, r1x, r1y = turning_centres(x1, y1, c1, s1, rho)
+    return dubins_lower_bound(l0x, l0y, r0x, r0y, l1x, l1y, r1x, r1y, turn, rho)
+

@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from planner._dubins import dubins_length_cs, dubins_lower_bound_cs
+from planner._dubins import dubins_length_cs, dubins_lower_bound, turning_centres
 from planner._paths import path_end, truncate, wrap_angle
 from planner._rng import uniform
 from planner._reeds_shepp import reeds_shepp_length
@@ -32,6 +32,7 @@ from planner._world import World, motion_free, static_clearance_estimate
 (EPS, GAMMA, GOAL_BIAS, RHO, SPEED, GX, GY, GTH, GPOS, GHEAD, INFORMED, STAR, REVERSE,
  SX, SY, K_RRT, NPARAMS) = range(17)
 LANE_SHARE, LANE_SIGMA = 0.9, 0.25  # track scenarios: headings sampled along the lane
+NEAREST_BUCKETS = 256  # nearest's queue: half-cell buckets, the last one takes the rest
 # Counter indices.
 N, NGOAL, ITER, CHECKS, BEST, REWIRES, EVALS, FIRST_ITER, REFUSED = range(9)
 # Event row columns (only written when the event buffers are non-empty).
@@ -41,7 +42,8 @@ EV_ITER, EV_XR, EV_YR, EV_THR, EV_NEAREST, EV_NEW, EV_PARENT, EV_NEAR_START, EV_
 
 class Tree(NamedTuple):
     pose: np.ndarray  # (cap, 3)
-    trig: np.ndarray  # (cap, 2): cos θ, sin θ (Dubins lengths then need no trigonometry)
+    trig: np.ndarray  # (cap, 6): cos θ, sin θ and the turning circles' centres (left x, y,
+    # right x, y): Dubins lengths and bounds then need no trigonometry
     cost: np.ndarray  # (cap,) driven length from the root
     parent: np.ndarray  # (cap,) int64, -1 for the root
     kinds: np.ndarray  # (cap, 5) int8: the edge from the parent
@@ -72,7 +74,7 @@ class Events(NamedTuple):
 def new_tree(capacity: int, grid: np.ndarray, rng: np.ndarray) -> Tree:
     nx, ny = int(grid[3]), int(grid[4])
     return Tree(
-        pose=np.zeros((capacity, 3)), trig=np.zeros((capacity, 2)), cost=np.zeros(capacity),
+        pose=np.zeros((capacity, 3)), trig=np.zeros((capacity, 6)), cost=np.zeros(capacity),
         parent=np.full(capacity, -1, np.int64), kinds=np.zeros((capacity, 5), np.int8),
         lens=np.zeros((capacity, 5)), first_child=np.full(capacity, -1, np.int64),
         next_sibling=np.full(capacity, -1, np.int64), cell_head=np.full(nx * ny, -1, np.int64),
@@ -113,8 +115,10 @@ def add_node(tree: Tree, P: np.ndarray, x, y, th, cost, parent, kinds, lens) -> 
     tree.pose[k, 0] = x
     tree.pose[k, 1] = y
     tree.pose[k, 2] = th
-    tree.trig[k, 0] = math.cos(th)
-    tree.trig[k, 1] = math.sin(th)
+    c, s = math.cos(th), math.sin(th)
+    tree.trig[k, 0] = c
+    tree.trig[k, 1] = s
+    tree.trig[k, 2:6] = turning_centres(x, y, c, s, P[RHO])
     tree.cost[k] = cost
     tree.parent[k] = parent
     tree.kinds[k, :] = kinds
@@ -191,11 +195,13 @@ def _cheap_bound(x0, y0, th0, x1, y1, th1, rho) -> float:
 @njit(cache=True, inline="always")
 def _bound_to(tree: Tree, P, j, x, y, th, c, s) -> float:
     """A cheap lower bound of the steering length from node j to the pose (x, y, th) with
-    cos and sin c, s: the forward-path bound for Dubins, `_cheap_bound` with reversing."""
+    cos and sin c, s: the turning circles' bound for Dubins, `_cheap_bound` with reversing."""
     if P[REVERSE] > 0.0:
         return _cheap_bound(tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], x, y, th, P[RHO])
-    return dubins_lower_bound_cs(tree.pose[j, 0], tree.pose[j, 1], tree.trig[j, 0],
-                                 tree.trig[j, 1], x, y, c, s, P[RHO])
+    lx, ly, rx, ry = turning_centres(x, y, c, s, P[RHO])
+    f = tree.trig
+    return dubins_lower_bound(f[j, 2], f[j, 3], f[j, 4], f[j, 5], lx, ly, rx, ry,
+                              wrap_angle(th - tree.pose[j, 2]), P[RHO])
 
 
 @njit(cache=True, inline="always")
@@ -203,8 +209,10 @@ def _bound_from(tree: Tree, P, x, y, th, c, s, j) -> float:
     """`_bound_to` the other way: from the pose to node j."""
     if P[REVERSE] > 0.0:
         return _cheap_bound(x, y, th, tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], P[RHO])
-    return dubins_lower_bound_cs(x, y, c, s, tree.pose[j, 0], tree.pose[j, 1], tree.trig[j, 0],
-                                 tree.trig[j, 1], P[RHO])
+    lx, ly, rx, ry = turning_centres(x, y, c, s, P[RHO])
+    f = tree.trig
+    return dubins_lower_bound(lx, ly, rx, ry, f[j, 2], f[j, 3], f[j, 4], f[j, 5],
+                              wrap_angle(tree.pose[j, 2] - th), P[RHO])
 
 
 @njit(cache=True, inline="always")
@@ -269,39 +277,48 @@ def _heap_pop(keys, vals, size) -> int:
 def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
     """(node, steering length) of the tree node with the shortest car path to the query pose.
 
-    Best first: grid rings are opened outward, their nodes enter a min-heap keyed by a lower
-    bound of their path length, and exact lengths are computed in increasing bound order, so
-    the first ones are usually near-optimal and the search stops when neither the heap's top
-    nor the next ring's distance can beat the best length found.
+    Best first: grid rings are opened outward and their nodes filed by a lower bound of their
+    path length into buckets half a cell wide; exact lengths are computed bucket by bucket,
+    lowest first, for buckets that no unopened ring can undercut (a node in ring k is at
+    least (k − 1) cells away), so the first ones are usually near-optimal and the search
+    stops when neither a bucket nor the next ring can beat the best length found. Filing
+    costs a store where a heap cost a sift.
     """
     qc, qs = math.cos(qth), math.sin(qth)
     nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
     ci, cj = _cell(tree, qx, qy)
     cells = np.empty(8 * (max(nx, ny) + 1), np.int64)
-    keys, vals = tree.near_key, tree.stack  # scratch: free until choose-parent
-    size = 0
+    width = 0.5 * cell
+    head = np.full(NEAREST_BUCKETS, -1, np.int64)
+    link, key = tree.stack, tree.near_key  # per node; scratch until choose-parent
+    cur, top = 0, -1  # the lowest bucket that may be non-empty, the highest filed into
     best, besti = math.inf, -1
     k = 0
     last_ring = max(nx, ny)
     while True:
         ring_bound = max(0.0, (k - 1) * cell) if k <= last_ring else math.inf
-        if size > 0 and keys[0] <= ring_bound:
-            key, node = keys[0], vals[0]
-            if key >= best:
-                break  # every remaining candidate, opened or not, is at least this far
-            size = _heap_pop(keys, vals, size)
-            d = _length_to(tree, P, node, qx, qy, qth, qc, qs, best)
-            if d < best:
-                best, besti = d, node
+        while cur <= top and head[cur] < 0:
+            cur += 1
+        if cur <= top and cur * width <= ring_bound and cur * width < best:
+            node = head[cur]
+            head[cur] = link[node]
+            if key[node] < best:
+                d = _length_to(tree, P, node, qx, qy, qth, qc, qs, best)
+                if d < best:
+                    best, besti = d, node
         elif ring_bound >= best:
-            break
+            break  # every remaining candidate, filed or not, is at least this far
         else:
             for q in range(_ring_cells(tree, ci, cj, k, cells)):
                 node = tree.cell_head[cells[q]]
                 while node >= 0:
                     lb = _bound_to(tree, P, node, qx, qy, qth, qc, qs)
                     if lb < best:
-                        size = _heap_push(keys, vals, size, lb, node)
+                        b = min(int(lb / width), NEAREST_BUCKETS - 1)
+                        key[node] = lb
+                        link[node] = head[b]
+                        head[b] = node
+                        cur, top = min(cur, b), max(top, b)
                     node = tree.cell_next[node]
             k += 1
     return besti, best
@@ -375,14 +392,20 @@ def _near(tree: Tree, x, y, radius, k_nearest) -> int:
             m = k_nearest
         return m
     kr = int(math.ceil(radius / cell))
+    x0, y0, r2 = tree.grid[0], tree.grid[1], radius * radius
     for i in range(max(ci - kr, 0), min(ci + kr, nx - 1) + 1):
+        gx = max(x0 + i * cell - x, 0.0, x - x0 - (i + 1) * cell)  # to the cell's column
         for j in range(max(cj - kr, 0), min(cj + kr, ny - 1) + 1):
+            gy = max(y0 + j * cell - y, 0.0, y - y0 - (j + 1) * cell)
+            if gx * gx + gy * gy > r2:
+                continue  # the whole cell lies outside the ball
             node = tree.cell_head[i * ny + j]
             while node >= 0:
-                d = math.hypot(tree.pose[node, 0] - x, tree.pose[node, 1] - y)
-                if d <= radius:
+                dx, dy = tree.pose[node, 0] - x, tree.pose[node, 1] - y
+                d2 = dx * dx + dy * dy
+                if d2 <= r2:
                     tree.near[m] = node
-                    tree.near_len[m] = d
+                    tree.near_len[m] = math.sqrt(d2)
                     m += 1
                 node = tree.cell_next[node]
     return m
@@ -521,7 +544,8 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
             ev.rows[row, EV_THR] = thr
         if static_clearance_estimate(w, xr, yr) <= 0.0:
             # SampleFree: a sample inside a static obstacle is rejected at once (it still
-            # counts as an iteration, as OMPL counts its rejected informed samples).
+            # counts as an iteration: OMPL's RRT* spends a nearest search and a failed
+            # motion check on it).
             continue
         near_i, dist = nearest(tree, P, xr, yr, thr)
         nx0, ny0, nth0 = tree.pose[near_i, 0], tree.pose[near_i, 1], tree.pose[near_i, 2]

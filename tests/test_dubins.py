@@ -81,25 +81,38 @@ def test_bounded_length_never_underestimates(q0, q1, bound):
         assert bounded >= bound - 1e-12
 
 
+def lower_bound(a, b):
+    turn = (b[2] - a[2] + math.pi) % (2 * math.pi) - math.pi
+    return dubins_lower_bound_cs(a[0], a[1], math.cos(a[2]), math.sin(a[2]), b[0], b[1],
+                                 math.cos(b[2]), math.sin(b[2]), turn, RHO)
+
+
 @settings(max_examples=500, deadline=None)
 @given(pose, pose, st.floats(-1e-3, 1e-3), st.floats(-1e-3, 1e-3))
 def test_cheap_lower_bound_never_exceeds_the_length(q0, q1, jx, jy):
     # jx, jy: also nearby pairs (offsets under a millimetre), where the bound is tightest.
     for a, b in ((q0, q1), (q0, (q0[0] + jx, q0[1] + jy, q1[2]))):
         exact = dubins_length(*a, *b, RHO, math.inf)
-        bound = dubins_lower_bound_cs(a[0], a[1], math.cos(a[2]), math.sin(a[2]), b[0], b[1],
-                                      math.cos(b[2]), math.sin(b[2]), RHO)
-        assert bound <= exact + 1e-9
+        assert lower_bound(a, b) <= exact + 1e-9
+        assert lower_bound(a, b) >= math.hypot(b[0] - a[0], b[1] - a[1]) - 1e-9
 
 
-def test_cheap_lower_bound_is_tight_behind_and_large_beside():
-    """A pose straight behind another with the same heading: the bound is the chord; beside it:
-    at least half a turn, where the chord and |Δθ| alone give nearly nothing."""
-    cos0, sin0 = 1.0, 0.0
-    assert dubins_lower_bound_cs(0, 0, cos0, sin0, 2.0, 0, cos0, sin0, RHO) == pytest.approx(2.0)
-    beside = dubins_lower_bound_cs(0, 0, cos0, sin0, 0.0, 0.1, cos0, sin0, RHO)
-    assert beside == pytest.approx(math.pi * RHO)
-    assert dubins_length(0, 0, 0, 0.0, 0.1, 0, RHO, math.inf) >= beside
+@pytest.mark.parametrize("q1, expected", [
+    ((2.0, 0.0, 0.0), 2.0),  # straight behind: the chord
+    ((0.0, 2 * RHO, math.pi), math.pi * RHO),  # a half circle to the left: exact
+    ((0.0, 0.0, math.pi), (2 + math.pi) * RHO),  # facing back on the spot: a loop
+    ((0.3, 0.0, math.pi), None),  # facing back just ahead
+])
+def test_cheap_lower_bound_is_tight_on_arcs_and_large_facing_back(q1, expected):
+    """The chord and |Δθ| give at most ρπ where the car has to turn round on the spot; the
+    turning circles' bound sees the loop (the length there is about 7.3 ρ)."""
+    bound = lower_bound((0.0, 0.0, 0.0), q1)
+    exact = dubins_length(0.0, 0.0, 0.0, *q1, RHO, math.inf)
+    assert bound <= exact + 1e-12
+    if expected is not None:
+        assert bound == pytest.approx(expected)
+    else:
+        assert bound > 1.5 * math.pi * RHO
 
 
 @settings(max_examples=100, deadline=None)

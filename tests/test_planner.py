@@ -133,3 +133,27 @@ def test_live_poses_are_a_read_only_view_and_the_root_edge_is_a_dot():
     poses = run.poses
     assert np.array_equal(poses, run.snapshot().pose) and not poses.flags.writeable
     assert run.edge_points(0, 4) == pytest.approx(np.repeat(poses[:1, :2], 5, axis=0))
+
+
+@pytest.mark.parametrize("steering", ["dubins", "reeds-shepp"])
+@pytest.mark.parametrize("name", ["hallway", "oval_track"])
+def test_nearest_is_the_true_nearest_by_steering_length(name, steering):
+    """The pruned best-first search returns what a scan of every node returns (OMPL's way)."""
+    from planner import _kernel as K
+    from planner._dubins import dubins_length
+    from planner._reeds_shepp import reeds_shepp_length
+    from planner.rrt import Planner, PlannerSettings
+
+    problem = planner.compile_problem(planner.parse_scenario(scenario_dict(name)))
+    run = Planner(problem, PlannerSettings(steering=steering, seed=3))
+    run.step(3000)
+    tree, n = run._tree, run.nodes
+    length = dubins_length if steering == "dubins" else reeds_shepp_length
+    rng = np.random.default_rng(0)
+    xmin, ymin, xmax, ymax = problem.bounds
+    for _ in range(150):
+        q = (rng.uniform(xmin, xmax), rng.uniform(ymin, ymax), rng.uniform(-math.pi, math.pi))
+        node, found = K.nearest(tree, run._P, *q)
+        lengths = [length(*tree.pose[j], *q, problem.rho, math.inf) for j in range(n)]
+        assert found == pytest.approx(min(lengths), abs=1e-9)
+        assert lengths[node] == pytest.approx(found, abs=1e-9)
