@@ -228,4 +228,3 @@ def dubins_lower_bound_cs(x0, y0, c0, s0, x1, y1, c1, s1, turn, rho) -> float:
     l0x, l0y, r0x, r0y = turning_centres(x0, y0, c0, s0, rho)
     l1x, l1y, r1x, r1y = turning_centres(x1, y1, c1, s1, rho)
     return dubins_lower_bound(l0x, l0y, r0x, r0y, l1x, l1y, r1x, r1y, turn, rho)
-

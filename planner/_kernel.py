@@ -1,10 +1,10 @@
 """The compiled RRT / RRT* iteration (LaValle 1998; Karaman & Frazzoli 2011) for a car.
 
 Data live in flat arrays (`Tree`), positions in a uniform grid that grows with the tree. The
-Euclidean distance between positions is a lower bound of every car path length, so nearest and
-near queries scan grid cells outward and compute exact steering lengths only for the few nodes
-whose Euclidean distance can still beat the best so far (OMPL instead computes a Dubins length to
-every node, every iteration).
+Euclidean distance between positions, and for Dubins the turning circles' bound, are lower
+bounds of every car path length, so nearest and near queries scan grid cells outward and compute
+exact steering lengths only for the few nodes whose bound can still beat the best so far (OMPL
+instead computes a Dubins length to every node, every iteration).
 
 Rewiring keeps the rewired child's full SE(2) state: with exact steering the new edge ends at
 exactly the old pose, so the subtree stays kinematically valid and only its costs (and, with
