@@ -110,9 +110,10 @@ def _shortest_word(dx, dy, c0, s0, c1, s1, bound):
         best = _keep(best, 3, _mod2pi(-a + th), p, _mod2pi(-b + th))
     if best[1] + best[2] + best[3] <= math.pi:
         return best  # CCC words are never shorter than π
+    sab = sb * ca - cb * sa  # sin(β − α)
     # RLR
     tmp = 0.125 * (6.0 - d * d + 2.0 * cab + 2.0 * d * (sa - sb))
-    if abs(tmp) <= 1.0 and _ccc_middle_bound(tmp) < best[1] + best[2] + best[3]:
+    if abs(tmp) <= 1.0 and _ccc_bound(tmp, cab, sab) < best[1] + best[2] + best[3]:
         a, b = _angles(a, b, ca, sa, cb, sb)
         p = _TWO_PI - math.acos(tmp)
         th = math.atan2(ca - cb, d - sa + sb)
@@ -120,7 +121,7 @@ def _shortest_word(dx, dy, c0, s0, c1, s1, bound):
         best = _keep(best, 4, t, p, _mod2pi(a - b - t + p))
     # LRL
     tmp = 0.125 * (6.0 - d * d + 2.0 * cab + 2.0 * d * (-sa + sb))
-    if abs(tmp) <= 1.0 and _ccc_middle_bound(tmp) < best[1] + best[2] + best[3]:
+    if abs(tmp) <= 1.0 and _ccc_bound(tmp, cab, -sab) < best[1] + best[2] + best[3]:
         a, b = _angles(a, b, ca, sa, cb, sb)
         p = _TWO_PI - math.acos(tmp)
         th = math.atan2(-ca + cb, d + sa - sb)
@@ -149,10 +150,16 @@ def _arcs_bound(ct, st, ca, sa, cb, sb, sign_t, sign_q) -> float:
 
 
 @njit(cache=True, inline="always")
-def _ccc_middle_bound(x) -> float:
-    """A lower bound of a CCC word's middle arc 2π − acos(x) without the acos: acos(x) ≤ π/2 − x
-    for x ≥ 0 and ≤ π/2 + (π/2)|x| for x < 0 (asin is convex on [0, 1])."""
-    return 1.5 * math.pi + x if x >= 0.0 else 1.5 * math.pi + 0.5 * math.pi * x
+def _ccc_bound(x, cd, sd) -> float:
+    """A lower bound of a CCC word's length t + p + q without acos or atan2, given x = cos p
+    and the cosine and sine of the word's net turning ±(β − α) signed so that t + q ≡ p − it
+    (mod 2π): then t + q ≥ (p − it) mod 2π, bounded by `_arc_bound`. The middle arc
+    p = 2π − acos(x) is at least its bound below (acos(x) ≤ π/2 − x for x ≥ 0 and
+    ≤ π/2 + (π/2)|x| for x < 0: asin is convex on [0, 1]). Without the outer arcs nearly every
+    pose facing back at a node passed as a possible CCC word and paid for three atan2."""
+    p_low = 1.5 * math.pi + x if x >= 0.0 else 1.5 * math.pi + 0.5 * math.pi * x
+    sp = -math.sqrt(max(1.0 - x * x, 0.0))  # sin p ≤ 0 for p in [π, 2π]
+    return p_low + _arc_bound(x * cd + sp * sd, sp * cd - x * sd)
 
 
 @njit(cache=True, inline="always")

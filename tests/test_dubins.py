@@ -81,6 +81,21 @@ def test_bounded_length_never_underestimates(q0, q1, bound):
         assert bounded >= bound - 1e-12
 
 
+near_pose = st.tuples(st.floats(-4 * RHO, 4 * RHO), st.floats(-4 * RHO, 4 * RHO), angle)
+
+
+@settings(max_examples=500, deadline=None)
+@given(near_pose)
+def test_a_bound_a_hair_above_the_length_still_finds_it(q1):
+    """Every early exit (a word's cheap lower bound) really is below that word's length: with
+    the bound barely above the shortest length nothing may be cut. Nearby poses are where the
+    CCC words and their outer-arc bound matter."""
+    q0 = (0.0, 0.0, 0.0)
+    exact = dubins_length(*q0, *q1, RHO, math.inf)
+    assert dubins_length(*q0, *q1, RHO, exact * (1 + 1e-9) + 1e-12) == pytest.approx(
+        exact, abs=1e-9)
+
+
 def lower_bound(a, b):
     turn = (b[2] - a[2] + math.pi) % (2 * math.pi) - math.pi
     return dubins_lower_bound_cs(a[0], a[1], math.cos(a[2]), math.sin(a[2]), b[0], b[1],
