@@ -163,7 +163,7 @@ def _edges_distance(edges, a, b, px, py):
     return math.sqrt(best), inside
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _point_obstacles(w: World, x: float, y: float, t: float, moving: bool, c: float) -> float:
     """min(c, distance from the point (x, y) to the moving (or the static) obstacles at t),
     negative inside one."""
@@ -199,7 +199,7 @@ def _point_obstacles(w: World, x: float, y: float, t: float, moving: bool, c: fl
     return c
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _point_static(w: World, x: float, y: float) -> float:
     """Signed distance from a point to the bounds, the drivable region's edge and the static
     obstacles (the car's size is subtracted per footprint disc by the callers)."""
@@ -271,14 +271,34 @@ def static_clearance_estimate(w: World, x: float, y: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def clearance_bound(w: World, x: float, y: float, c: float, s: float, t: float) -> float:
-    """A lower bound of `pose_clearance` at the pose (x, y) with heading cos and sin c, s,
-    exact near obstacles and O(1) in open space.
+def _grid_bound(sdf, sdf_geo, discs, x, y, c, s) -> float:
+    """The grid's lower bound of the clearance at the pose (x, y) with heading cos and sin c, s,
+    or −inf where it is not good enough: a footprint disc off the grid or within 2 cells of an
+    obstacle. Takes arrays, not the World, so a loop calling it pays no reference counting.
 
     Point clearance is 1-Lipschitz, so the value stored at the nearest cell centre minus the
-    distance to it (≤ h/√2) bounds it from below; only where that bound is small do we compute
-    exactly.
+    distance to it (≤ h/√2) bounds it from below.
     """
+    x0, y0, h = sdf_geo[0], sdf_geo[1], sdf_geo[2]
+    low = math.inf
+    for k in range(discs.shape[0]):
+        a, r = discs[k, 0], discs[k, 1]
+        cx, cy = x + a * c, y + a * s
+        i = int((cx - x0) / h)
+        j = int((cy - y0) / h)
+        if not (0 <= i < sdf.shape[0] and 0 <= j < sdf.shape[1] and cx >= x0 and cy >= y0):
+            return -math.inf
+        d = sdf[i, j] - 0.7072 * h - r
+        if d < 2.0 * h:
+            return -math.inf
+        low = min(low, d)
+    return low
+
+
+@njit(cache=True)
+def clearance_bound(w: World, x: float, y: float, c: float, s: float, t: float) -> float:
+    """A lower bound of `pose_clearance` at the pose (x, y) with heading cos and sin c, s,
+    exact near obstacles (`_grid_bound` elsewhere) and O(1) in open space."""
     x0, y0, h = w.sdf_geo[0], w.sdf_geo[1], w.sdf_geo[2]
     low = math.inf
     for k in range(w.discs.shape[0]):
@@ -308,6 +328,8 @@ def motion_free(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> boo
     """
     # A footprint disc at offset a moves at most (1 + a/ρ) times as far as the car drives.
     slow = 1.0 + w.geo[VMAX_OBS] / speed + w.geo[REACH] / rho
+    sdf, sdf_geo, discs = w.sdf, w.sdf_geo, w.discs
+    moving = w.m_kind.shape[0] > 0
     driven = 0.0
     for i in range(kinds.shape[0]):
         seg = lens[i]
@@ -326,7 +348,9 @@ def motion_free(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> boo
                 c, sn = math.cos(th + turn * direction * s), math.sin(th + turn * direction * s)
                 px, py = x + (sn - s0) / turn, y - (c - c0) / turn
             counter[0] += 1
-            d = clearance_bound(w, px, py, c, sn, t0 + (driven + s) / speed)
+            d = -math.inf if moving else _grid_bound(sdf, sdf_geo, discs, px, py, c, sn)
+            if d == -math.inf:
+                d = clearance_bound(w, px, py, c, sn, t0 + (driven + s) / speed)
             if d <= CONTACT:
                 return False
             if s >= length:
