@@ -12,9 +12,9 @@ moving obstacles, its arrival times) change. The seed thesis duplicated nodes in
 its edges did not fix the heading; see docs/planner.md. With moving obstacles a rewire is taken
 only if every edge of the rewired subtree is still free at its new, earlier times.
 
-Helpers called in every iteration are inlined (``inline="always"``): a compiled call that takes
-the Tree or the World counts references to each of their ~20 arrays up and down, atomically,
-which took a quarter of the time (perf: NRT_incref / NRT_decref).
+The sampling and ring-walk helpers are inlined (``inline="always"``): a compiled call that takes
+the Tree or the World counts references to each of their ~20 arrays up and down, atomically
+(perf: NRT_incref / NRT_decref; see docs/planner.md).
 """
 
 from __future__ import annotations
