@@ -211,10 +211,10 @@ def _bound_to(tree: Tree, P, j, x, y, th, c, s) -> float:
 
 @njit(cache=True, inline="always")
 def _word_bound_to(tree: Tree, P, j, x, y, th, c, s) -> float:
-    """A tighter, dearer bound than `_bound_to` (Dubins: `dubins_word_bound`; with reversing
-    the same cheap bound)."""
+    """A tighter, dearer bound than `_bound_to` for Dubins (`dubins_word_bound`); with
+    reversing there is none, and 0 leaves `_bound_to`'s standing."""
     if P[REVERSE] > 0.0:
-        return _cheap_bound(tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], x, y, th, P[RHO])
+        return 0.0
     lx, ly, rx, ry = turning_centres(x, y, c, s, P[RHO])
     f = tree.trig
     return dubins_word_bound(f[j, 2], f[j, 3], f[j, 4], f[j, 5], f[j, 0], f[j, 1], lx, ly, rx,

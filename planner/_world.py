@@ -271,25 +271,28 @@ def static_clearance_estimate(w: World, x: float, y: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def _grid_bound(sdf, sdf_geo, discs, x, y, c, s) -> float:
-    """The grid's lower bound of the clearance at the pose (x, y) with heading cos and sin c, s,
-    or −inf where it is not good enough: a footprint disc off the grid or within 2 cells of an
-    obstacle. Takes arrays, not the World, so a loop calling it pays no reference counting.
-
-    Point clearance is 1-Lipschitz, so the value stored at the nearest cell centre minus the
-    distance to it (≤ h/√2) bounds it from below.
-    """
+def _disc_grid_bound(sdf, sdf_geo, cx, cy, r) -> float:
+    """The grid's lower bound of the clearance of a footprint disc of radius r centred at
+    (cx, cy), or −inf off the grid. Point clearance is 1-Lipschitz, so the value stored at the
+    nearest cell centre minus the distance to it (≤ h/√2) bounds it from below."""
     x0, y0, h = sdf_geo[0], sdf_geo[1], sdf_geo[2]
+    i = int((cx - x0) / h)
+    j = int((cy - y0) / h)
+    if not (0 <= i < sdf.shape[0] and 0 <= j < sdf.shape[1] and cx >= x0 and cy >= y0):
+        return -math.inf
+    return sdf[i, j] - 0.7072 * h - r
+
+
+@njit(cache=True, inline="always")
+def _grid_bound(sdf, sdf_geo, discs, x, y, c, s) -> float:
+    """`_disc_grid_bound` of the whole footprint at the pose (x, y) with heading cos and sin
+    c, s, or −inf where it is not good enough: a disc off the grid or within 2 cells of an
+    obstacle. Takes arrays, not the World, so a loop calling it pays no reference counting."""
     low = math.inf
     for k in range(discs.shape[0]):
         a, r = discs[k, 0], discs[k, 1]
-        cx, cy = x + a * c, y + a * s
-        i = int((cx - x0) / h)
-        j = int((cy - y0) / h)
-        if not (0 <= i < sdf.shape[0] and 0 <= j < sdf.shape[1] and cx >= x0 and cy >= y0):
-            return -math.inf
-        d = sdf[i, j] - 0.7072 * h - r
-        if d < 2.0 * h:
+        d = _disc_grid_bound(sdf, sdf_geo, x + a * c, y + a * s, r)
+        if d < 2.0 * sdf_geo[2]:
             return -math.inf
         low = min(low, d)
     return low
@@ -297,20 +300,14 @@ def _grid_bound(sdf, sdf_geo, discs, x, y, c, s) -> float:
 
 @njit(cache=True)
 def clearance_bound(w: World, x: float, y: float, c: float, s: float, t: float) -> float:
-    """A lower bound of `pose_clearance` at the pose (x, y) with heading cos and sin c, s,
-    exact near obstacles (`_grid_bound` elsewhere) and O(1) in open space."""
-    x0, y0, h = w.sdf_geo[0], w.sdf_geo[1], w.sdf_geo[2]
+    """A lower bound of `pose_clearance` at the pose (x, y) with heading cos and sin c, s:
+    the grid's (`_disc_grid_bound`) in open space, exact within 2 cells of an obstacle."""
     low = math.inf
     for k in range(w.discs.shape[0]):
         a, r = w.discs[k, 0], w.discs[k, 1]
         cx, cy = x + a * c, y + a * s
-        i = int((cx - x0) / h)
-        j = int((cy - y0) / h)
-        if 0 <= i < w.sdf.shape[0] and 0 <= j < w.sdf.shape[1] and cx >= x0 and cy >= y0:
-            d = w.sdf[i, j] - 0.7072 * h - r
-            if d < 2.0 * h:
-                d = _point_static(w, cx, cy) - r
-        else:
+        d = _disc_grid_bound(w.sdf, w.sdf_geo, cx, cy, r)
+        if d < 2.0 * w.sdf_geo[2]:
             d = _point_static(w, cx, cy) - r
         if w.m_kind.shape[0] > 0:
             d = _point_obstacles(w, cx, cy, t, True, d + r) - r
