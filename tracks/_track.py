@@ -14,6 +14,7 @@ from tracks._profile import Profile, driving_profile
 from tracks._segments import Segment
 
 STEERING_COLUMNS = ("s", "x", "y", "heading", "steering_deg")
+MAX_DETAIL_POINTS = 5000
 
 
 def _positive(name: str, value: float) -> float:
@@ -120,8 +121,10 @@ class Track:
 
     def detail_spacing(self) -> float:
         """A sampling step that shows the track's shape: 5 cm, finer on a narrow track (a
-        quarter of its width), so a 30 cm track drawn in millimetres keeps its curves."""
-        return min(0.05, self.width_m / 4.0)
+        quarter of its width), so a 30 cm track drawn in millimetres keeps its curves; but
+        never more than `MAX_DETAIL_POINTS` samples, so a long track, or a scenario's bounds
+        drawn as a hairline frame, stays light to draw and to plan in."""
+        return max(min(0.05, self.width_m / 4.0), self.length_m / MAX_DETAIL_POINTS)
 
     def region_rings(self, spacing: float | None = None) -> list[np.ndarray]:
         """The drivable region as polygon rings (each (N, 2), not repeating its first point),
