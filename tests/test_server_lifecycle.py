@@ -52,12 +52,28 @@ def test_data_survive_a_restart_and_an_interrupted_job_is_marked(tmp_path):
         assert second.stop(signal.SIGINT) < 5
 
 
+def _alive(pid: int) -> bool:
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except FileNotFoundError:
+        return False
+    return "State:\tZ" not in status
+
+
 def test_a_crash_mid_job_is_marked_after_restart(tmp_path):
     first = Server(tmp_path)
     job = first.client.post("/jobs", json={"scenarios": [scenario_dict("slalom")],
                                            "parameters": [{"time": 3}]}).json()
     time.sleep(0.5)
+    workers = [int(p) for p in subprocess.run(["pgrep", "-P", str(first.proc.pid)],
+                                              capture_output=True, text=True).stdout.split()]
+    assert workers
     first.stop(signal.SIGKILL)
+    # Its workers (one mid-run) do not live on as orphans: they follow the server.
+    deadline = time.monotonic() + 10
+    while any(map(_alive, workers)) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(map(_alive, workers)), [p for p in workers if _alive(p)]
     second = Server(tmp_path)
     try:
         job = second.client.get(f"/jobs/{job['id']}").json()

@@ -14,6 +14,8 @@ import functools
 import multiprocessing
 import os
 import signal
+import threading
+import time
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
@@ -28,12 +30,24 @@ __all__ = ["Planning", "first_line", "machine_workers"]
 
 INTERRUPTED = "interrupted by a server shutdown"
 CRASHED = "interrupted: the server stopped before the job finished"
+PARENT_POLL_S = 0.5
 
 
-def _worker_start() -> None:
-    """Workers leave Ctrl-C to the server (which terminates them) and load the kernels now."""
+def _worker_start(server: int) -> None:
+    """Workers leave Ctrl-C to the server (which terminates them), end with it even when it is
+    killed (-9: nothing terminates them then), and load the kernels now."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_exit_with_parent, args=(server,), daemon=True,
+                     name="exit-with-server").start()
     warm_up()
+
+
+def _exit_with_parent(server: int) -> None:
+    """End this worker, mid-run or idle, once its server is gone (re-parented away; this may
+    have happened before the worker got here)."""
+    while os.getppid() == server:
+        time.sleep(PARENT_POLL_S)
+    os._exit(1)
 
 
 def first_line(exc: BaseException) -> str:
@@ -62,7 +76,7 @@ class Planning:
     def _start_pool(self) -> ProcessPoolExecutor:
         # spawn, not fork: the server process runs threads (uvicorn, viser, sqlite).
         pool = ProcessPoolExecutor(self.workers, multiprocessing.get_context("spawn"),
-                                   initializer=_worker_start)
+                                   initializer=_worker_start, initargs=(os.getpid(),))
         for _ in range(self.workers):  # start every worker now, not at the first request
             pool.submit(int)
         return pool
