@@ -36,14 +36,20 @@ class Limits:
 
 def limit_commands(v_prev: float, steer_prev: float, v_want: float, steer_want: float,
                    limits: Limits, dt: float) -> tuple[float, float]:
-    """The commands the actuators can realise this tick, nearest to the wanted ones."""
-    dv = limits.max_accel * dt
-    ds = limits.max_steer_rate * dt
+    """The commands the actuators can realise this tick, nearest to the wanted ones; a
+    feasible command passes unchanged, bit for bit."""
     v = min(max(v_want, -limits.max_speed), limits.max_speed)
-    v = min(max(v, v_prev - dv), v_prev + dv)
     s = min(max(steer_want, -limits.max_steer), limits.max_steer)
-    s = min(max(s, steer_prev - ds), steer_prev + ds)
-    return v, s
+    return (_toward(v_prev, v, limits.max_accel * dt),
+            _toward(steer_prev, s, limits.max_steer_rate * dt))
+
+
+def _toward(previous: float, wanted: float, step: float) -> float:
+    """``wanted`` if it is within ``step`` of ``previous``, else ``previous`` moved by ``step``
+    towards it. Decided on the difference, not on ``previous ± step`` (which rounds)."""
+    if abs(wanted - previous) <= step:
+        return wanted
+    return previous + math.copysign(step, wanted - previous)
 
 
 def arc_step(x, y, th, v, steer, wheelbase: float, dt: float):
