@@ -12,18 +12,13 @@ from __future__ import annotations
 
 import argparse
 import statistics
-from pathlib import Path
 
+import _harness
 from tqdm import tqdm
 
 import planner
 
-HERE = Path(__file__).resolve().parent
-SCENES = {
-    "crossing": HERE.parents[1] / "shared" / "scenarios" / "crossing.json",
-    "gate": HERE / "scenarios" / "gate.json",
-    "movers": HERE / "scenarios" / "movers.json",
-}
+SCENES = ["crossing", "gate", "movers"]  # bundled scenarios
 
 
 def frozen(scenario: planner.Scenario) -> planner.Scenario:
@@ -50,8 +45,8 @@ def main(argv: list[str] | None = None) -> None:
     planner.rrt.warm_up()
     rows = []
     with tqdm(total=len(SCENES) * args.seeds * 2, unit="run") as bar:
-        for name, path in SCENES.items():
-            scenario = planner.load_scenario(path)
+        for name in SCENES:
+            scenario = planner.load_scenario(name)
             for label, scn in (("moving", scenario), ("frozen at t=0", frozen(scenario))):
                 results = []
                 for seed in range(args.seeds):
@@ -72,11 +67,10 @@ def main(argv: list[str] | None = None) -> None:
     lines += ["| " + " | ".join(row) + " |" for row in rows]
     table = "\n".join(lines)
     print(table)
-    out = HERE / "results" / "moving.md"
-    out.parent.mkdir(exist_ok=True)
-    out.write_text(f"# Moving obstacles, {args.seeds} seeds, {args.time:g} s budget\n\n"
-                   f"Command: `python benchmarks/bench_moving.py`\n\n{table}\n")
+    title = f"# Moving obstacles, {args.seeds} seeds, {args.time:g} s budget"
+    _harness.write_result(
+        "moving", f"{title}\n\nCommand: `python benchmarks/bench_moving.py`\n\n{table}\n")
 
 
 if __name__ == "__main__":
-    main()
+    _harness.run(main)

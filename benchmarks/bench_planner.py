@@ -22,20 +22,19 @@ import time
 from datetime import date
 from pathlib import Path
 
+import _harness
 from tqdm import tqdm
 
-SCENARIO_DIR = Path(__file__).resolve().parents[2] / "shared" / "scenarios"
 STATIC_SCENARIOS = ["open_field", "hallway", "slalom", "parking", "oval_track"]
 OMPL_PLANNERS = ["RRTstar", "InformedRRTstar", "BITstar"]
 OURS = "ours"
-RESULTS_MD = Path(__file__).resolve().parent / "results" / "planner.md"
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenarios", nargs="+", default=STATIC_SCENARIOS, metavar="NAME",
-                        help="scenario names (crossing has a moving obstacle OMPL cannot express)")
-    parser.add_argument("--scenario-dir", type=Path, default=SCENARIO_DIR)
+                        help="bundled scenario names (crossing has a moving obstacle OMPL "
+                             "cannot express)")
     parser.add_argument("--seeds", nargs="+", type=int, default=list(range(5)))
     parser.add_argument("--budgets", nargs="+", type=float, default=[0.1, 1.0], metavar="SECONDS")
     parser.add_argument("--only", choices=[OURS, "ompl"], help="run only our planner or only OMPL")
@@ -227,7 +226,9 @@ def report(summary: dict, args: argparse.Namespace, command: str, seconds: float
 
 def main(argv: list[str] | None = None) -> None:
     args = parse_args(argv)
-    paths = {name: args.scenario_dir / f"{name}.json" for name in args.scenarios}
+    import planner
+
+    paths = {name: planner.bundled_scenario_path(name) for name in args.scenarios}
     scenarios = {name: json.loads(path.read_text()) for name, path in paths.items()}
     runs_per_planner = len(paths) * len(args.seeds)
     n_ompl = 0 if args.only == OURS else runs_per_planner * len(OMPL_PLANNERS) * len(args.budgets)
@@ -246,11 +247,10 @@ def main(argv: list[str] | None = None) -> None:
     text = report(summarise(records, args.budgets), args, command, time.perf_counter() - start)
 
     print(text)
-    RESULTS_MD.parent.mkdir(exist_ok=True)
-    RESULTS_MD.write_text(text)
+    _harness.write_result("planner", text)
     if args.json:
         args.json.write_text(json.dumps(records, indent=1))
 
 
 if __name__ == "__main__":
-    main()
+    _harness.run(main)

@@ -12,20 +12,16 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import json
 import os
 import re
 import subprocess
 import sys
 import tempfile
 import time
-from pathlib import Path
 
+import _harness
 import httpx
 import numpy as np
-
-SCENARIO = Path(__file__).resolve().parents[2] / "shared" / "scenarios" / "slalom.json"
-RESULTS = Path(__file__).resolve().parent / "results" / "server.md"
 
 
 def start_server(data_dir: str) -> tuple[subprocess.Popen, str]:
@@ -70,7 +66,7 @@ def ms(values, q) -> str:
 
 
 async def run(url: str, clients: int, plan_s: float, duration: float) -> str:
-    body = {"scenario": json.loads(SCENARIO.read_text()), "time": plan_s}
+    body = {"scenario_id": "slalom", "time": plan_s}  # a bundled scenario
     plans, health, errors = [], [], []
     limits = httpx.Limits(max_connections=clients + 1)
     async with httpx.AsyncClient(base_url=url, timeout=60, limits=limits) as client:
@@ -110,10 +106,9 @@ def main() -> None:
             proc.terminate()
             proc.wait(20)
     print(report)
-    RESULTS.parent.mkdir(exist_ok=True)
-    RESULTS.write_text(report)
+    _harness.write_result("server", report)
     sys.exit(0 if "errors: 0" in report else 1)
 
 
 if __name__ == "__main__":
-    main()
+    _harness.run(main)

@@ -3,13 +3,13 @@
     python benchmarks/bench_simulate.py              # 5 scenes x 20 seeds, replanning on and off
     python benchmarks/bench_simulate.py --seeds 5 --jobs 1 --scenes thesis_laps
 
-Scenes: the reference crossing, three of benchmarks/scenarios/ in which a mover stops in the
+Scenes (bundled scenarios): the reference crossing, three in which a mover stops in the
 lane, turns into it, or backs up into it — so that a plan made once at t = 0 collides — and two
 laps of the thesis track among static boxes and track-following movers (lap mode; there
 "replanning off" keeps extending the path to the rolling goal, but on the t = 0 sensing alone).
 Cycle times are measured wall-clock times on this machine (noisy when it is shared); "wall /
-sim" is a run's wall time (scenario compilation included) over the time it simulated. Writes
-benchmarks/results/simulate.md after each scene.
+sim" is a run's wall time (scenario compilation included) over the time it simulated. Shows a
+progress bar and rewrites benchmarks/results/simulate.md after each scene.
 """
 
 from __future__ import annotations
@@ -18,18 +18,12 @@ import argparse
 import statistics
 import time
 from concurrent.futures import ProcessPoolExecutor
-from pathlib import Path
 
+import _harness
 import numpy as np
+from tqdm import tqdm
 
-HERE = Path(__file__).resolve().parent
-SCENES = {
-    "crossing": HERE.parents[1] / "shared" / "scenarios" / "crossing.json",
-    "stop_in_lane": HERE / "scenarios" / "stop_in_lane.json",
-    "turn_into_lane": HERE / "scenarios" / "turn_into_lane.json",
-    "back_up": HERE / "scenarios" / "back_up.json",
-    "thesis_laps": HERE / "scenarios" / "thesis_laps.json",
-}
+SCENES = ["crossing", "stop_in_lane", "turn_into_lane", "back_up", "thesis_laps"]
 LAPS = {"thesis_laps": 2}  # lap mode: laps to drive; other scenes drive to their goal
 
 
@@ -43,7 +37,7 @@ def one(job: tuple[str, int, bool, float]) -> dict:
     warm_up()  # once per process: kernel loading is not part of a run's wall time
     warm_up_replanning()
     started = time.perf_counter()
-    run = simulate(planner.load_scenario(SCENES[name]),
+    run = simulate(planner.load_scenario(name),
                    SimSettings(duration=duration, seed=seed, replan=replan, laps=LAPS.get(name)))
     wall = time.perf_counter() - started
     return {"scene": name, "seed": seed, "replan": replan, **run.summary,
@@ -74,7 +68,7 @@ def table(rows: list[dict]) -> str:
 
 def _groups(rows):
     keys = sorted({(r["scene"], r["replan"]) for r in rows},
-                  key=lambda k: (list(SCENES).index(k[0]), not k[1]))
+                  key=lambda k: (SCENES.index(k[0]), not k[1]))
     return [(k, [r for r in rows if (r["scene"], r["replan"]) == k]) for k in keys]
 
 
@@ -83,22 +77,24 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--duration", type=float, default=40.0)
     parser.add_argument("--jobs", type=int, default=1, help="parallel runs (noisier timings)")
-    parser.add_argument("--scenes", nargs="+", choices=list(SCENES), default=list(SCENES))
-    parser.add_argument("--out", type=Path, default=HERE / "results" / "simulate.md")
+    parser.add_argument("--scenes", nargs="+", choices=SCENES, default=SCENES)
     args = parser.parse_args(argv)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
     rows = []
-    with ProcessPoolExecutor(args.jobs) as pool:
+    with (ProcessPoolExecutor(args.jobs) as pool,
+          tqdm(total=len(args.scenes) * 2 * args.seeds, unit="run") as bar):
         for name in args.scenes:  # the table is rewritten after each scene
-            rows += pool.map(one, [(name, seed, replan, args.duration)
-                                   for replan in (True, False) for seed in range(args.seeds)])
+            bar.set_postfix_str(name)
+            for row in pool.map(one, [(name, seed, replan, args.duration)
+                                      for replan in (True, False) for seed in range(args.seeds)]):
+                rows.append(row)
+                bar.update()
             text = (f"# Simulated car: replanning at 30 Hz vs one plan at t = 0\n\n"
                     f"{args.seeds} seeds per scene, {args.duration:g} s at most, defaults "
                     f"otherwise (pure pursuit, 100 Hz control, 10 Hz sensing, measured cycle "
                     f"times); {', '.join(f'{k}: {n} laps' for k, n in LAPS.items())}.\n\n"
                     f"{table(rows)}\n")
-            args.out.write_text(text)
-            print(text, flush=True)
+            _harness.write_result("simulate", text)
+    print(text, flush=True)
     for name in args.scenes:
         done = [r for r in rows if r["scene"] == name and r["replan"] and r["reached_goal"]]
         if done and name in LAPS:
@@ -110,4 +106,4 @@ def main(argv: list[str] | None = None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    _harness.run(main)

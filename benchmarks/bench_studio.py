@@ -7,6 +7,8 @@ the updates (websocket frames) per second the client receives (goal: ≥ 20), an
 second at growing tree sizes (goal: bounded, not growing with the tree).
 
     python benchmarks/bench_studio.py [--nodes 10000] [--json out.json]
+
+Prints the numbers and writes them to benchmarks/results/studio.md.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import threading
 import time
 from pathlib import Path
 
+import _harness
 import msgspec
 import viser
 import websockets.sync.client
@@ -27,13 +30,9 @@ from app.studio._actions import load_scenario
 from app.studio._worker import PlannerWorker
 from planner.rrt import warm_up
 
-SCENARIO = Path(__file__).resolve().parents[1] / "benchmarks" / "scenarios" / "open_field.json"
-SHARED = Path("/work/shared/scenarios/open_field.json")
-
 
 def _scenario() -> dict:
-    path = SCENARIO if SCENARIO.exists() else SHARED
-    return json.loads(path.read_text())
+    return json.loads(planner.bundled_scenario_path("open_field").read_text())
 
 
 class Wire:
@@ -145,7 +144,18 @@ def main() -> None:
     print(json.dumps(out, indent=2))
     if args.json:
         args.json.write_text(json.dumps(out, indent=2) + "\n")
+    _harness.write_result("studio", _markdown(out))
+
+
+def _markdown(out: dict) -> str:
+    lines = [f"# The studio's cost to the planner ({out['scenario']}, {out['nodes']} nodes)", "",
+             "Command: `python benchmarks/bench_studio.py`", "",
+             f"Iterations/s alone {out['iterations_per_s_alone']}, with the live view "
+             f"{out['iterations_per_s_with_ui']}: the UI costs {out['ui_cost_percent']} %.", "",
+             "| nodes | updates/s | bytes/s |", "|---:|---:|---:|"]
+    lines += [f"| {r['nodes']} | {r['updates_per_s']} | {r['bytes_per_s']} |" for r in out["wire"]]
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":
-    main()
+    _harness.run(main)

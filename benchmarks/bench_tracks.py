@@ -1,12 +1,15 @@
 """Tracks benchmark: import + resample + profiles of the thesis track, and steering commands.
 
 Run: python benchmarks/bench_tracks.py   (goals: ≤ 10 ms and ≤ 0.1 ms; the 2011 thesis: 5 ms)
+Prints the table and writes it to benchmarks/results/tracks.md.
 """
 
 from __future__ import annotations
 
 import statistics
 import time
+
+import _harness
 
 from tracks import library_names, library_path, load_library_track, load_svg
 
@@ -50,11 +53,16 @@ def main() -> None:
             0.1e-3,
         )
     )
-    print(f"{'case':46} {'median':>10} {'best':>10} {'goal':>10}")
+    lines = ["| case | median | best | goal |", "|---|---:|---:|---:|"]
     for label, median, best, goal in rows:
         goal_text = f"{goal * 1e3:.3g} ms" if goal else ""
-        print(f"{label:46} {median * 1e3:8.3f} ms {best * 1e3:7.3f} ms {goal_text:>10}")
+        lines.append(f"| {label.strip()} | {median * 1e3:.3f} ms | {best * 1e3:.3f} ms | "
+                     f"{goal_text} |")
+    text = ("# Tracks: SVG import, profiles, steering commands\n\n"
+            "Command: `python benchmarks/bench_tracks.py`\n\n" + "\n".join(lines) + "\n")
+    print(text)
+    _harness.write_result("tracks", text)
 
 
 if __name__ == "__main__":
-    main()
+    _harness.run(main)

@@ -8,7 +8,7 @@ OMPL's random seed is process-wide and takes effect only before the first random
 each run needs a fresh process: `run_ompl_isolated` (used by bench_planner.py) starts one; run as a
 script, this file plans one run and prints its result as a JSON line:
 
-    python benchmarks/ompl_baseline.py /work/shared/scenarios/slalom.json --planner BITstar
+    python benchmarks/ompl_baseline.py planner/scenarios/slalom.json --planner BITstar
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 Importable without any web dependency. Typical use::
 
     import planner
-    scenario = planner.load_scenario("scenarios/slalom.json")
+    scenario = planner.load_scenario("slalom")   # a bundled name or a scenario file
     result = planner.solve(scenario, algorithm="rrtstar", time_limit=1.0, seed=0)
 """
 
@@ -12,12 +12,20 @@ from __future__ import annotations
 from planner.problem import Problem, compile_problem
 from planner.rrt import Planner, PlannerSettings, Result, TreeEvents, TreeSnapshot
 from planner.rrt import solve as _solve_problem
-from planner.scenario import Scenario, ScenarioError, load_scenario, parse_scenario, scenario_schema
+from planner.scenario import (
+    Scenario,
+    ScenarioError,
+    bundled_scenario_path,
+    load_scenario,
+    parse_scenario,
+    scenario_names,
+    scenario_schema,
+)
 
 __all__ = [
     "Planner", "PlannerSettings", "Problem", "Result", "Scenario", "ScenarioError",
-    "TreeEvents", "TreeSnapshot", "compile_problem", "load_scenario", "parse_scenario",
-    "scenario_schema", "solve",
+    "TreeEvents", "TreeSnapshot", "bundled_scenario_path", "compile_problem", "load_scenario",
+    "parse_scenario", "scenario_names", "scenario_schema", "solve",
 ]
 
 

@@ -16,7 +16,17 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-__all__ = ["ScenarioError", "Scenario", "load_scenario", "parse_scenario", "scenario_schema"]
+__all__ = [
+    "Scenario",
+    "ScenarioError",
+    "bundled_scenario_path",
+    "load_scenario",
+    "parse_scenario",
+    "scenario_names",
+    "scenario_schema",
+]
+
+LIBRARY = Path(__file__).parent / "scenarios"
 
 
 class ScenarioError(ValueError):
@@ -255,14 +265,32 @@ def parse_scenario(data: Any) -> Scenario:
         raise ScenarioError(f"invalid scenario: {_describe(exc)}") from None
 
 
-def load_scenario(path: str | Path) -> Scenario:
-    """Read and validate a scenario file (minimal FORMAT.md or the rich schema)."""
-    path = Path(path)
+def scenario_names() -> list[str]:
+    """Names of the scenarios bundled with Trackstar (planner/scenarios/), sorted."""
+    return sorted(p.stem for p in LIBRARY.glob("*.json"))
+
+
+def bundled_scenario_path(name: str) -> Path:
+    """The file of bundled scenario ``name``: the reference scenarios, the benchmark scenes and
+    half laps of the thesis track (`scenario_names()` lists them)."""
+    if name not in scenario_names():
+        raise ScenarioError(f"no bundled scenario {name!r}; choose from "
+                            f"{', '.join(scenario_names())}")
+    return LIBRARY / f"{name}.json"
+
+
+def load_scenario(source: str | Path) -> Scenario:
+    """Read and validate a scenario: a file (minimal FORMAT.md or the rich schema) or, when no
+    such file exists, the name of a bundled scenario (``load_scenario("slalom")``)."""
+    path = Path(source)
+    if not path.is_file() and str(source) in scenario_names():
+        path = bundled_scenario_path(str(source))
+    elif not path.exists():
+        hint = f" (bundled: {', '.join(scenario_names())})" if path.suffix == "" else ""
+        raise ScenarioError(f"no such scenario file or bundled scenario: {source}{hint}")
     try:
         text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ScenarioError(f"no such scenario file: {path}") from None
-    except (IsADirectoryError, UnicodeDecodeError) as exc:
+    except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(f"cannot read scenario {path}: {exc}") from None
     try:
         data = json.loads(text, parse_constant=_reject_constant)

@@ -1,10 +1,9 @@
-"""Shared fixtures: the reference scenarios of ../shared/scenarios and a scenario loader."""
+"""Shared fixtures: the bundled reference scenarios and the compiled planner."""
 
 from __future__ import annotations
 
 import json
 import os
-from pathlib import Path
 
 import pytest
 from hypothesis import settings
@@ -15,13 +14,14 @@ settings.register_profile("ci", derandomize=True, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
 
-# shared/ sits beside the repository, here and in CI.
-SCENARIOS = Path(__file__).resolve().parents[2] / "shared" / "scenarios"
 STATIC = ["open_field", "hallway", "slalom", "parking", "oval_track"]
 
 
 def scenario_dict(name: str) -> dict:
-    return json.loads((SCENARIOS / f"{name}.json").read_text())
+    """A bundled scenario's JSON object, to modify in a test."""
+    import planner
+
+    return json.loads(planner.bundled_scenario_path(name).read_text())
 
 
 @pytest.fixture(scope="session", autouse=True)

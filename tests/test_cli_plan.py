@@ -5,8 +5,7 @@ import subprocess
 import time
 
 import pytest
-
-from conftest import SCENARIOS, scenario_dict
+from conftest import scenario_dict
 
 
 def run(*args, timeout=120):
@@ -14,7 +13,7 @@ def run(*args, timeout=120):
 
 
 def test_plan_prints_one_json_object_with_the_contract_keys():
-    out = run("plan", str(SCENARIOS / "slalom.json"), "--json", "--time", "0.5")
+    out = run("plan", "slalom", "--json", "--time", "0.5")
     assert out.returncode == 0, out.stderr
     data = json.loads(out.stdout)
     for key in ("solved", "cost", "time_to_first_solution_s", "iterations", "nodes",
@@ -26,7 +25,7 @@ def test_plan_prints_one_json_object_with_the_contract_keys():
 
 
 def test_plan_with_iterations_is_reproducible_and_echoes_options():
-    args = ("plan", str(SCENARIOS / "open_field.json"), "--json", "--iterations", "800",
+    args = ("plan", "open_field", "--json", "--iterations", "800",
             "--seed", "3", "--planner", "rrt", "--steering", "dubins")
     a, b = json.loads(run(*args).stdout), json.loads(run(*args).stdout)
     assert a["path"] == b["path"] and a["iterations"] == b["iterations"]
@@ -35,14 +34,14 @@ def test_plan_with_iterations_is_reproducible_and_echoes_options():
 
 
 def test_moving_obstacles_give_timed_paths():
-    data = json.loads(run("plan", str(SCENARIOS / "crossing.json"), "--json",
+    data = json.loads(run("plan", "crossing", "--json",
                           "--iterations", "2000").stdout)
     assert data["solved"] and all(len(p) == 4 for p in data["path"])
     assert data["arrival_time_s"] == pytest.approx(data["path"][-1][3])
 
 
 def test_human_summary_without_json():
-    out = run("plan", str(SCENARIOS / "slalom.json"), "--iterations", "1500")
+    out = run("plan", "slalom", "--iterations", "1500")
     assert out.returncode == 0 and "cost" in out.stdout and "iterations" in out.stdout
 
 
@@ -59,7 +58,7 @@ def test_unsolved_is_exit_0_with_solved_false(tmp_path):
 
 
 @pytest.mark.parametrize("content, message", [
-    (None, "no such scenario file"),
+    (None, "no such scenario file or bundled scenario"),
     ("{not json", "not valid JSON"),
     ('{"name": "x", "bounds": [0, 0, 1, 1], "start": [0.5, 0.5, 0], "goal": [0.6, 0.6, 0], '
      '"obstacles": [], "vehicel": {}}', "did you mean 'vehicle'"),
@@ -82,12 +81,65 @@ def test_bad_input_exits_2_with_one_line_quickly(tmp_path, content, message):
     assert len(lines) == 1 and message in lines[0]
 
 
-def test_bad_options_exit_2():
-    assert run("plan", str(SCENARIOS / "slalom.json"), "--planner", "prm").returncode == 2
-    assert run("plan", str(SCENARIOS / "slalom.json"), "--time", "-1").returncode == 2
+@pytest.mark.parametrize("args, words", [
+    (("plan", "slalom", "--planner", "prm"), "'--planner'"),
+    (("plan", "slalom", "--steering", "foo"), "'foo' is not one of"),
+    (("plan", "slalom", "--time", "-1"), "--time must be > 0"),
+    (("plan", "slalom", "--iterations", "0"), "'--iterations'"),
+    (("plan",), "Missing argument"),
+    (("plan", "slalom", "--bogus"), "No such option: --bogus"),
+    (("nonsense",), "No such command"),
+])
+def test_usage_errors_exit_2_with_one_line(args, words):
+    out = run(*args)
+    assert out.returncode == 2 and out.stdout == ""
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and words in lines[0], out.stderr
+
+
+def test_help_keeps_bracketed_defaults_and_units():
+    plan = run("plan", "--help").stdout
+    assert "[default: 1.0, or none when --iterations is given]" in " ".join(plan.split())
+    sample = " ".join(run("track", "sample", "--help").stdout.split())
+    assert "[m]" in sample and "Wheelbase L [m]" in sample
+
+
+def test_bundled_scenarios_by_name_from_any_directory(tmp_path):
+    listed = json.loads(run("scenario", "list", "--json").stdout)
+    names = [r["name"] for r in listed]
+    assert names == sorted(names)
+    for name in ("open_field", "hallway", "slalom", "parking", "oval_track", "crossing"):
+        assert name in names
+    kinds = {r["name"]: r["moving"] for r in listed}
+    assert kinds["crossing"] and not kinds["slalom"] and kinds["thesis_half_lap"]
+    assert all(r["description"] for r in listed)
+    text = run("scenario", "list").stdout.splitlines()
+    assert len(text) == len(listed) and text[0].split()[:2] == [names[0], "moving"
+                                                                  if listed[0]["moving"]
+                                                                  else "static"]
+    out = subprocess.run(["trackstar", "plan", "slalom", "--time", "0.3", "--json"],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and json.loads(out.stdout)["solved"], out.stderr
+    assert run("scenario", "check", "thesis_static").stdout.strip() == "thesis_static: ok"
+
+
+def test_a_file_beside_a_bundled_name_wins_and_unknown_names_list_the_bundled(tmp_path):
+    scn = scenario_dict("open_field")
+    scn["name"] = "my-field"
+    (tmp_path / "slalom").write_text(json.dumps(scn))
+    out = subprocess.run(["trackstar", "scenario", "check", "slalom"], cwd=tmp_path,
+                         capture_output=True, text=True, timeout=120)
+    assert out.stdout.strip() == "my-field: ok"
+    out = run("plan", "slalmo")
+    assert out.returncode == 2 and "bundled: back_up, crossing" in out.stderr
+
+
+def test_rrt_says_it_stops_at_its_first_solution():
+    out = run("plan", "slalom", "--planner", "rrt", "--time", "0.5")
+    assert out.returncode == 0 and "RRT stops at its first solution" in out.stdout
 
 
 def test_scenario_schema_and_check():
     schema = json.loads(run("scenario", "schema").stdout)
     assert schema["title"] == "Scenario"
-    assert run("scenario", "check", str(SCENARIOS / "crossing.json")).returncode == 0
+    assert run("scenario", "check", "crossing").returncode == 0

@@ -6,12 +6,12 @@ import math
 import numpy as np
 import pytest
 import shapely
+from checker import densify
+from conftest import scenario_dict
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import planner
-from checker import densify
-from conftest import scenario_dict
 from planner.scenario import Footprint
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from checker import pose_valid
-from conftest import SCENARIOS, scenario_dict
+from conftest import scenario_dict
 
 import planner
 from planner._world import build_world
@@ -269,7 +269,7 @@ def test_follow_track_hands_over_to_the_replanner_which_reaches_the_goal():
 # -- the bundled example and the command line ------------------------------------------------
 def test_hallway_example_reaches_the_goal_without_touching_anything():
     scn = scenario_dict("hallway")
-    run = simulate(planner.load_scenario(SCENARIOS / "hallway.json"),
+    run = simulate(planner.load_scenario("hallway"),
                    SimSettings(duration=60.0, fixed_latency_ms=20.0),
                    behaviour=parse_fsm(json.loads(EXAMPLE.read_text())))
     s = run.summary
@@ -289,7 +289,7 @@ def _cli(*args, timeout=120):
 
 def test_cli_drives_by_the_machine_and_logs_the_state(tmp_path):
     log = tmp_path / "run.csv"
-    r = _cli(SCENARIOS / "hallway.json", "--behaviour", EXAMPLE, "--fixed-latency", 20,
+    r = _cli("hallway", "--behaviour", EXAMPLE, "--fixed-latency", 20,
              "--json", "--log", log)
     assert r.returncode == 0, r.stderr
     s = json.loads(r.stdout)
@@ -318,6 +318,6 @@ def test_cli_rejects_a_bad_machine_in_one_line(tmp_path, content, needle):
     path = tmp_path / "fsm.json"
     if content is not None:
         path.write_text(content)
-    r = _cli(SCENARIOS / "hallway.json", "--behaviour", path, "--json", timeout=30)
+    r = _cli("hallway", "--behaviour", path, "--json", timeout=30)
     assert r.returncode == 2 and r.stdout == ""
     assert len(r.stderr.strip().splitlines()) == 1 and needle in r.stderr, r.stderr

@@ -4,12 +4,12 @@ import math
 
 import numpy as np
 import pytest
+from checker import first_collision, obstacle_offset
+from conftest import scenario_dict
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import planner
-from checker import first_collision, obstacle_offset
-from conftest import scenario_dict
 from planner._world import build_world, offset
 
 

@@ -4,10 +4,10 @@ import math
 
 import numpy as np
 import pytest
-
-import planner
 from checker import arc_mismatch, first_collision
 from conftest import STATIC, scenario_dict
+
+import planner
 
 
 def plan(name, iterations=3000, **kw):

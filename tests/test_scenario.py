@@ -4,16 +4,17 @@ import copy
 import json
 
 import pytest
+from conftest import scenario_dict
 
 import planner
-from conftest import SCENARIOS, scenario_dict
 
 
-@pytest.mark.parametrize("path", sorted(SCENARIOS.glob("*.json")), ids=lambda p: p.stem)
-def test_every_reference_scenario_reads_unchanged(path):
-    scn = planner.load_scenario(path)
-    raw = json.loads(path.read_text())
-    assert scn.name == raw["name"] and len(scn.obstacles) == len(raw["obstacles"])
+@pytest.mark.parametrize("name", planner.scenario_names())
+def test_every_bundled_scenario_reads_unchanged_under_its_name(name):
+    scn = planner.load_scenario(name)
+    raw = scenario_dict(name)
+    assert scn.name == raw["name"] == name and len(scn.obstacles) == len(raw["obstacles"])
+    assert scn.description, "a bundled scenario says what it is about"
     assert scn.has_motion == any("motion" in ob for ob in raw["obstacles"])
 
 

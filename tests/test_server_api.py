@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import xml.etree.ElementTree as ET
 
 import pytest
 from _server import Server
-from conftest import SCENARIOS, scenario_dict
+from conftest import scenario_dict
 
+import planner
 import tracks
 
 SVG_NS = 'xmlns="http://www.w3.org/2000/svg" xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape"'
@@ -37,7 +39,13 @@ def test_health_landing_and_docs(server):
     assert health == {"status": "ok", "version": "0.1.0", "ui_port": server.ui_port}
     landing = server.get("/")
     assert landing.status_code == 200 and 'href="/docs"' in landing.text
-    assert server.get("/docs").status_code == 200
+    docs = server.get("/docs")
+    assert docs.status_code == 200
+    # Offline: Swagger UI's script and style come from this server, not a CDN.
+    assets = re.findall(r'(?:src|href)="([^"]+\.(?:js|css))"', docs.text)
+    assert len(assets) == 2 and all(a.startswith("/") for a in assets), assets
+    for asset in assets:
+        assert server.get(asset).status_code == 200, asset
     paths = server.get("/openapi.json").json()["paths"]
     for path in ("/api/v1/tracks", "/api/v1/tracks/{track_id}/profile", "/api/v1/plan",
                  "/api/v1/jobs/{job_id}/results.csv", "/api/v1/scenarios/{scenario_id}"):
@@ -153,10 +161,28 @@ def test_scenarios_crud(server):
     assert created.status_code == 201
     record = created.json()
     assert record["name"] == "slalom" and record["scenario"] == body
+    assert record["source"] == "upload" and record["id"] != "slalom"
     assert server.client.get(f"/scenarios/{record['id']}").json() == record
     assert record in server.client.get("/scenarios").json()
     assert server.client.delete(f"/scenarios/{record['id']}").status_code == 204
     assert server.client.get(f"/scenarios/{record['id']}").status_code == 404
+
+
+REFERENCE = ["open_field", "hallway", "slalom", "parking", "oval_track", "crossing"]
+
+
+def test_bundled_scenarios_come_first_read_only_and_plan_by_name(server):
+    listed = server.client.get("/scenarios").json()
+    names = planner.scenario_names()
+    assert [r["id"] for r in listed[:len(names)]] == names and set(REFERENCE) <= set(names)
+    assert all(r["source"] == "library" and r["id"] == r["name"] for r in listed[:len(names)])
+    slalom = server.client.get("/scenarios/slalom").json()
+    assert slalom["scenario"] == scenario_dict("slalom")
+    resp = server.client.delete("/scenarios/slalom")
+    assert resp.status_code == 403 and "bundled" in resp.json()["detail"]
+    assert server.client.get("/scenarios/slalom").status_code == 200
+    report = server.client.post("/plan", json={"scenario_id": "slalom", "time": 0.3}).json()
+    assert report["scenario"] == "slalom" and report["solved"]
 
 
 def _broken(change) -> dict:
@@ -187,7 +213,7 @@ def test_plan_is_the_cli_plan_json(server):
     options = {"iterations": 800, "seed": 3, "planner": "rrt"}
     got = server.client.post("/plan", json={"scenario": scenario_dict("open_field"), **options})
     assert got.status_code == 200, got.text
-    cli = subprocess.run(["trackstar", "plan", str(SCENARIOS / "open_field.json"), "--json",
+    cli = subprocess.run(["trackstar", "plan", "open_field", "--json",
                           "--iterations", "800", "--seed", "3", "--planner", "rrt"],
                          capture_output=True, text=True, check=True)
     report, expected = got.json(), json.loads(cli.stdout)

@@ -12,7 +12,7 @@ import time
 
 import pytest
 from _server import Server
-from conftest import SCENARIOS, scenario_dict
+from conftest import scenario_dict
 
 THESIS = {"name": "thesis-plain", "track": {"name": "thesis"},
           "vehicle": {"wheelbase": 0.44, "max_steer_deg": 26, "radius": 0.1, "speed": 1.0},
@@ -47,7 +47,7 @@ def test_summary_and_log_are_those_of_the_cli(server, tmp_path):
     sim, _ = _wait(server, created.json()["id"])
     assert sim["status"] == "done" and sim["progress"] == 1.0 and sim["error"] is None
     assert sim["scenario"] == "crossing" and sim["settings"]["controller"] == "stanley"
-    cli = subprocess.run(["trackstar", "simulate", SCENARIOS / "crossing.json", "--duration", "3",
+    cli = subprocess.run(["trackstar", "simulate", "crossing", "--duration", "3",
                           "--seed", "5", "--fixed-latency", "20", "--controller", "stanley",
                           "--json", "--log", tmp_path / "cli.csv"],
                          capture_output=True, text=True, check=True, timeout=120)

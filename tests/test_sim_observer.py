@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-from conftest import SCENARIOS
 
 import planner
 from planner.sim import SimSettings, simulate
@@ -17,7 +16,7 @@ SETTINGS = SimSettings(duration=8.0, fixed_latency_ms=20.0, seed=3)
 
 @pytest.fixture(scope="module")
 def crossing():
-    return planner.load_scenario(SCENARIOS / "crossing.json")
+    return planner.load_scenario("crossing")
 
 
 @pytest.fixture(scope="module")

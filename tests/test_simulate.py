@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from checker import obstacle_offset, pose_valid
-from conftest import SCENARIOS, scenario_dict
+from conftest import scenario_dict
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -26,13 +26,14 @@ from planner.sim.control import CONTROLLERS, Reference, Tracking, steer_command
 from planner.sim.metrics import collision_runs
 from planner.sim.vehicle import Limits, arc_step, limit_commands
 
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "scenarios"
 FIXED = {"fixed_latency_ms": 20.0}
 
 
-def _run(path: Path, **kw):
-    scn = planner.load_scenario(path)
-    return json.loads(path.read_text()), simulate(scn, SimSettings(**{**FIXED, **kw}))
+def _run(source: str | Path, **kw):
+    """A simulated run of a scenario file or bundled name, with the scenario's JSON object."""
+    scn = planner.load_scenario(source)
+    raw = json.loads(Path(source).read_text()) if Path(source).is_file() else scenario_dict(source)
+    return raw, simulate(scn, SimSettings(**{**FIXED, **kw}))
 
 
 def _replay_error(log: np.ndarray, wheelbase: float, dt: float) -> float:
@@ -134,7 +135,7 @@ def test_controllers_follow_a_circle(name):
 # -- whole runs ----------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def crossing_run():
-    return _run(SCENARIOS / "crossing.json", duration=25.0, seed=1)
+    return _run("crossing", duration=25.0, seed=1)
 
 
 def test_crossing_obstacle_is_avoided(crossing_run):
@@ -155,7 +156,7 @@ def test_log_replays_and_respects_the_limits(crossing_run):
     dt = 0.01
     assert np.allclose(log[:, 0], np.arange(len(log)) * dt)
     assert _replay_error(log, 0.44, dt) < 1e-8
-    lim = Limits.of(planner.load_scenario(SCENARIOS / "crossing.json").vehicle)
+    lim = Limits.of(planner.load_scenario("crossing").vehicle)
     v = np.concatenate([[0.0], log[:, 4]])
     d = np.concatenate([[0.0], log[:, 5]])
     assert np.abs(d).max() <= lim.max_steer + 1e-12
@@ -171,10 +172,10 @@ def test_log_replays_and_respects_the_limits(crossing_run):
 def test_replanning_passes_movers_a_blind_plan_hits(scene):
     """A mover stops (or backs up) in the lane: the replanning car passes it, the car that
     follows its t = 0 plan collides — recounted independently from the log."""
-    scn, run = _run(BENCH / f"{scene}.json", duration=22.0, seed=2)
+    scn, run = _run(scene, duration=22.0, seed=2)
     assert run.summary["reached_goal"] and run.summary["collisions"] == 0
     assert _independent_collisions(scn, run.log) == 0
-    _, blind = _run(BENCH / f"{scene}.json", duration=22.0, seed=2, replan=False)
+    _, blind = _run(scene, duration=22.0, seed=2, replan=False)
     assert blind.summary["collisions"] >= 1
     assert _independent_collisions(scn, blind.log) == blind.summary["collisions"]
     assert blind.summary["min_clearance_m"] < 0
@@ -187,7 +188,7 @@ def _cli(*args, timeout=120):
 
 
 def test_cli_json_and_log_are_reproducible(tmp_path):
-    path = SCENARIOS / "crossing.json"
+    path = "crossing"
     outs = []
     for k in range(2):
         r = _cli(path, "--duration", 3, "--seed", 5, "--fixed-latency", 20, "--json",
@@ -225,7 +226,7 @@ def _with(tmp_path, name="crossing", **changes):
     (["--sense-rate", "0"], "--sense-rate"),
 ])
 def test_cli_rejects_bad_options(args, needle):
-    r = _cli(SCENARIOS / "crossing.json", *args, timeout=30)
+    r = _cli("crossing", *args, timeout=30)
     assert r.returncode == 2 and needle in r.stderr and len(r.stderr.strip().splitlines()) == 1
 
 
@@ -275,7 +276,7 @@ def test_fsm_errors_name_the_element(tmp_path, edit, message):
     r = _fsm_check(path)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert r.stderr.startswith(f"error: {message}"), r.stderr
-    r = _cli(SCENARIOS / "hallway.json", "--behaviour", path, timeout=30)
+    r = _cli("hallway", "--behaviour", path, timeout=30)
     assert r.returncode == 2 and message in r.stderr
 
 

@@ -17,13 +17,11 @@ import numpy as np
 import pytest
 import shapely
 from checker import pose_valid
-from conftest import SCENARIOS
+from conftest import scenario_dict
 
 import tracks
 from planner.sim.laps import LapCounter
 
-DATA = Path(__file__).resolve().parent / "data"
-SCENE = Path(__file__).resolve().parents[1] / "benchmarks" / "scenarios" / "thesis_laps.json"
 THESIS = tracks.load_library_track("thesis")
 CENTRE = (2.366, -2.297)  # inside the thesis loop: the middle of its bounding box
 
@@ -154,28 +152,28 @@ def test_lap_scene_collisions_recounted_independently(tmp_path):
     """The benchmark's lap scene (static boxes, movers ahead, oncoming and stopping): the car
     drives its lap untouched, and an independent check of the log agrees."""
     log_path = tmp_path / "run.csv"
-    r = _cli(SCENE, "--laps", 1, "--seed", 1, "--fixed-latency", 20, "--json",
+    r = _cli("thesis_laps", "--laps", 1, "--seed", 1, "--fixed-latency", 20, "--json",
              "--log", log_path, "--duration", 40)
     assert r.returncode == 0, r.stderr
     s = json.loads(r.stdout)
     _, log = _read_log(log_path)
-    scn = json.loads(SCENE.read_text())
+    scn = scenario_dict("thesis_laps")
     assert _independent_collisions(scn, log) == s["collisions"] == 0
     assert s["laps"] == 1
 
 
 def test_laps_without_a_track_is_exit_2_with_one_line():
-    r = _cli(SCENARIOS / "crossing.json", "--laps", 2)
+    r = _cli("crossing", "--laps", 2)
     assert r.returncode == 2
     assert r.stderr.strip().count("\n") == 0
     assert "--laps needs a scenario with a closed track" in r.stderr
-    r = _cli(DATA / "thesis_half_lap.json", "--laps", 0)
+    r = _cli("thesis_half_lap", "--laps", 0)
     assert r.returncode == 2 and "--laps must be at least 1" in r.stderr, r.stderr
 
 
 def test_the_first_plan_is_not_a_replan():
     """Replanning off: one plan, which replaced nothing."""
-    r = _cli(SCENARIOS / "crossing.json", "--no-replan", "--duration", 5, "--fixed-latency", 20,
+    r = _cli("crossing", "--no-replan", "--duration", 5, "--fixed-latency", 20,
              "--json")
     assert r.returncode == 0, r.stderr
     s = json.loads(r.stdout)

@@ -12,7 +12,8 @@ import time
 
 import numpy as np
 import test_studio_browser as sb
-from conftest import SCENARIOS
+
+import planner
 
 pytestmark = sb.pytestmark
 # The studio browser tests' fixtures: its server (ui_url, and urls where it has them) and chromium.
@@ -56,7 +57,7 @@ def test_simulate_plays_the_crossing_live(browser, ui_url):
     page.set_default_timeout(60000)  # a live run keeps software WebGL busy: screenshots queue
     thesis = sb.canvas_pixels(page)
     page.locator("input[type=file][accept='.json']").set_input_files(
-        str(SCENARIOS / "crossing.json"))
+        str(planner.bundled_scenario_path("crossing")))
     sb.wait_until(page, lambda img: np.abs(img - thesis).sum(axis=2).astype(bool).mean() > 0.2)
     sb.wait_still(page)
     lane = lane_box(sb.canvas_pixels(page, "sim_00_crossing"))

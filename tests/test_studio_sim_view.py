@@ -10,7 +10,6 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import viser
-from conftest import SCENARIOS
 
 import planner
 from app.studio._scene import yaw_wxyz
@@ -20,7 +19,7 @@ from app.studio._sim_view import EDGE_PIECES, SimView
 @pytest.fixture
 def view():
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
-    problem = planner.compile_problem(planner.load_scenario(SCENARIOS / "crossing.json"))
+    problem = planner.compile_problem(planner.load_scenario("crossing"))
     session = SimpleNamespace(
         client=SimpleNamespace(gui=server.gui), scene=server.scene, problem=problem,
         ui=SimpleNamespace(scene_time=server.gui.add_slider("Scene time (s)", 0.0, 30.0, 0.1,

@@ -1,20 +1,16 @@
 """Planning on a library track: the drivable region comes from the tracks layer."""
 
-import json
-from pathlib import Path
-
 import numpy as np
 import shapely
+from checker import densify
+from conftest import scenario_dict
 
 import planner
 import tracks
-from checker import densify
-
-SCENARIO = Path(__file__).parent / "data" / "thesis_half_lap.json"
 
 
 def test_half_lap_of_the_thesis_track_stays_on_the_track_and_off_the_box():
-    data = json.loads(SCENARIO.read_text())
+    data = scenario_dict("thesis_half_lap")
     result = planner.solve(planner.parse_scenario(data), time_limit=None, iterations=6000)
     assert result.solved
     # Independent check with shapely: the car's disc stays inside the drivable region.

@@ -1,8 +1,9 @@
 """The `trackstar` command line.
 
-Each command group lives in its own module; this one only assembles them and turns the domain
-errors of `tracks` and `planner` (all `ValueError` subclasses with a message a person can act on)
-into one line on stderr and exit status 2.
+Each command group lives in its own module; this one only assembles them and keeps the promise
+every command makes: bad input (a usage error, or a domain error of `tracks` and `planner`,
+all `ValueError` subclasses with a message a person can act on) ends with one line on stderr
+and exit status 2. Help is plain text, so bracketed defaults and units such as ``[m]`` show.
 """
 
 from __future__ import annotations
@@ -13,12 +14,18 @@ import typer
 
 from app.cli._errors import InputError
 
+# typer exports click's BadParameter only (newer releases vendor click); its bases are click's
+# UsageError and ClickException, which every parsing error derives from.
+UsageError = typer.BadParameter.__base__
+ClickException = UsageError.__base__
+
 cli = typer.Typer(
     name="trackstar",
     help="Plan the motion of car-like robots on race tracks.",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,
 )
 
 
@@ -37,7 +44,19 @@ _register()
 def main() -> None:
     """Console-script entry point."""
     try:
-        cli(standalone_mode=True)
+        code = cli(standalone_mode=False)
+    except ClickException as exc:
+        if type(exc).__name__ == "NoArgsIsHelpError":  # a bare group: its help, as click does
+            exc.show()
+            sys.exit(2)
+        where = f"{exc.ctx.command_path}: " if getattr(exc, "ctx", None) else ""
+        message = exc.format_message().replace("Value error, ", "")
+        print(f"error: {where}{message}", file=sys.stderr)
+        sys.exit(2)
+    except typer.Abort:
+        print("aborted", file=sys.stderr)
+        sys.exit(130)
     except InputError as exc:  # raised outside a command (rare: option parsing helpers)
         print(f"error: {exc}", file=sys.stderr)
         sys.exit(2)
+    sys.exit(code if isinstance(code, int) else 0)

@@ -1,15 +1,15 @@
-"""`trackstar plan` and `trackstar scenario …`: plan a scenario file, print or check schemas."""
+"""`trackstar plan` and `trackstar scenario …`: plan a scenario, list, check and describe them."""
 
 from __future__ import annotations
 
 import json
 from enum import Enum
-from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from app.cli._errors import user_errors
+from app.cli._warm import warm_kernels
 
 
 class Algorithm(str, Enum):
@@ -22,11 +22,16 @@ class Steering(str, Enum):
     reeds_shepp = "reeds-shepp"
 
 
-scenario_cli = typer.Typer(help="Scenario files: schema and validation.", no_args_is_help=True)
+scenario_cli = typer.Typer(help="Scenarios: the bundled ones, validation and the schema.",
+                           no_args_is_help=True, rich_markup_mode=None)
+
+ScenarioArg = Annotated[str, typer.Argument(
+    show_default=False, help="A bundled scenario's name (trackstar scenario list) or a scenario "
+                             "JSON file (FORMAT.md or the rich schema).")]
 
 
 def plan(
-    scenario: Annotated[Path, typer.Argument(help="Scenario JSON (FORMAT.md or the rich schema).")],
+    scenario: ScenarioArg,
     planner: Annotated[Algorithm, typer.Option(help="Planning algorithm.")] = Algorithm.rrtstar,
     steering: Annotated[Steering, typer.Option(help="Car steering.")] = Steering.dubins,
     time: Annotated[float | None, typer.Option(help="Time budget in seconds [default: 1.0, "
@@ -55,7 +60,9 @@ def plan(
             planner=planner.value, steering=steering.value, time=time, iterations=iterations,
             seed=seed, eps=eps, gamma=gamma, k_rrt=k_rrt, goal_bias=goal_bias,
             informed=informed, speed=speed)
-        report = run_plan(core.load_scenario(scenario), options)
+        scenario_model = core.load_scenario(scenario)
+        warm_kernels()
+        report = run_plan(scenario_model, options)
     if as_json:
         typer.echo(report.model_dump_json())
         return
@@ -71,7 +78,8 @@ def _print_summary(report) -> None:
         return
     typer.echo(f"  cost {report.cost:.3f} m, first solution after "
                f"{1000 * report.time_to_first_solution_s:.1f} ms")
-    typer.echo(f"  {report.iterations} iterations, {report.nodes} nodes, "
+    stop = " (RRT stops at its first solution; RRT* improves it)" if p["algorithm"] == "rrt" else ""
+    typer.echo(f"  {report.iterations} iterations{stop}, {report.nodes} nodes, "
                f"{report.collision_checks} motion checks, {report.rewires} rewires")
     typer.echo(f"  min clearance {report.min_clearance_m:.3f} m, "
                f"max |curvature| {report.max_abs_curvature:.3f} 1/m")
@@ -87,8 +95,30 @@ def schema() -> None:
     typer.echo(json.dumps(scenario_schema(), indent=2))
 
 
+@scenario_cli.command("list")
+def list_scenarios(
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON array.")] = False,
+) -> None:
+    """The bundled scenarios: name, static or moving obstacles, description."""
+    import planner as core
+
+    rows = []
+    for name in core.scenario_names():
+        scenario = core.load_scenario(core.bundled_scenario_path(name))
+        rows.append({"name": name, "moving": scenario.has_motion,
+                     "track": scenario.track.name if scenario.track else None,
+                     "description": scenario.description})
+    if as_json:
+        typer.echo(json.dumps(rows))
+        return
+    width = max(len(r["name"]) for r in rows)
+    for r in rows:
+        kind = "moving" if r["moving"] else "static"
+        typer.echo(f"{r['name']:<{width}}  {kind}  {r['description']}")
+
+
 @scenario_cli.command("check")
-def check(scenario: Annotated[Path, typer.Argument(help="Scenario JSON file.")]) -> None:
+def check(scenario: ScenarioArg) -> None:
     """Validate a scenario (schema, start and goal free); exit 2 with one line if it is not."""
     import planner as core
 

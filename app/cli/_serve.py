@@ -19,6 +19,7 @@ from typing import Annotated
 import typer
 
 from app.cli._errors import InputError, user_errors
+from app.cli._warm import warm_kernels
 
 
 def _listen(host: str, port: int, what: str) -> socket.socket:
@@ -101,6 +102,7 @@ def serve(
             print(f"warning: listening on {host}: the studio and the API have no "
                   "authentication; put them behind a reverse proxy that adds it",
                   file=sys.stderr, flush=True)
+        warm_kernels()  # before the studio and the workers need them: a first start compiles
         # uvicorn re-raises the stop signal once it has shut down; we have already stopped.
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, lambda *_: None)

@@ -10,10 +10,12 @@ from typing import Annotated
 import typer
 
 from app.cli._errors import user_errors
+from app.cli._plan import ScenarioArg
+from app.cli._warm import warm_kernels
 
 
 def simulate(
-    scenario: Annotated[Path, typer.Argument(help="Scenario JSON (FORMAT.md or the rich schema).")],
+    scenario: ScenarioArg,
     duration: Annotated[float, typer.Option(help="Simulated seconds at most.")] = 60.0,
     rate: Annotated[float, typer.Option(help="Replanning cycles per second.")] = 30.0,
     control_rate: Annotated[float, typer.Option(help="Control ticks per second.")] = 100.0,
@@ -54,6 +56,7 @@ def simulate(
         problem = core.compile_problem(core.load_scenario(scenario))
         if log is not None and not log.parent.is_dir():
             raise ValueError(f"--log: directory {str(log.parent)!r} does not exist")
+        warm_kernels()
         result = run_simulation(problem.scenario, settings, problem, behaviour=machine)
         if log is not None:
             result.write_log(log)
@@ -88,7 +91,8 @@ def _print_summary(name: str, s: dict) -> None:
         typer.echo(f"  cross-track error mean {e['mean']:.3f} m, max {e['max']:.3f} m")
 
 
-fsm_cli = typer.Typer(help="Behaviour state machines (JSON).", no_args_is_help=True)
+fsm_cli = typer.Typer(help="Behaviour state machines (JSON).", no_args_is_help=True,
+                      rich_markup_mode=None)
 
 
 @fsm_cli.command("check")

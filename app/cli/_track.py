@@ -16,7 +16,8 @@ import typer
 
 from app.cli._errors import user_errors
 
-track_cli = typer.Typer(help="Inspect, sample and plot Inkscape tracks.", no_args_is_help=True)
+track_cli = typer.Typer(help="Inspect, sample and plot Inkscape tracks.", no_args_is_help=True,
+                        rich_markup_mode=None)
 
 FileArg = Annotated[
     str, typer.Argument(metavar="FILE.svg", help="SVG file, or a library track name.")

@@ -12,6 +12,7 @@ from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
+from fastapi_offline import FastAPIOffline
 
 from app.server import routes_jobs, routes_plan, routes_scenarios, routes_simulations, routes_tracks
 from app.server.jobs import Planning
@@ -90,7 +91,8 @@ def create_app(settings: ServerSettings) -> FastAPI:
             await planning.shutdown()
             store.close()
 
-    app = FastAPI(
+    # /docs and /redoc from packaged assets, not a CDN: they work on an offline lab network.
+    app = FastAPIOffline(
         title="Trackstar",
         version=version("trackstar"),
         description="Tracks, scenarios, RRT/RRT* plans, batch jobs and simulated runs for "

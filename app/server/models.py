@@ -94,8 +94,9 @@ class TrackProfile(BaseModel):
 
 
 class ScenarioRecord(BaseModel):
-    id: str
+    id: str = Field(description="bundled scenarios: their name; posted ones: a generated id")
     name: str
+    source: Literal["library", "upload"]
     scenario: dict[str, Any] = Field(description="as posted (FORMAT.md or the rich schema)")
 
 

@@ -1,7 +1,9 @@
-"""/scenarios: stored planning problems, and the one way any route resolves a scenario."""
+"""/scenarios: the bundled library and stored planning problems, and the one way any route
+resolves a scenario (inline, a bundled name, or a stored id)."""
 
 from __future__ import annotations
 
+import json
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Body, HTTPException, Request, Response
@@ -14,7 +16,15 @@ from app.server.models import SCENARIO_EXAMPLE, ScenarioRecord
 router = APIRouter(tags=["scenarios"])
 
 
+def _library_record(name: str) -> dict:
+    body = json.loads(planner.bundled_scenario_path(name).read_text(encoding="utf-8"))
+    return {"id": name, "name": name, "source": "library", "scenario": body}
+
+
 def stored_scenario(request: Request, scenario_id: str) -> dict:
+    """The record of a bundled scenario (its name is its id) or of a stored one."""
+    if scenario_id in planner.scenario_names():
+        return _library_record(scenario_id)
     record = request.app.state.store.scenario(scenario_id)
     if record is None:
         raise HTTPException(404, f"no scenario {scenario_id!r} (GET /api/v1/scenarios lists them)")
@@ -55,12 +65,15 @@ async def create_scenario(
     body, track = resolve(request, scenario)
     await request.app.state.planning.check(body, track)
     scenario_id = request.app.state.store.add_scenario(body["name"], body)
-    return ScenarioRecord(id=scenario_id, name=body["name"], scenario=body)
+    return ScenarioRecord(id=scenario_id, name=body["name"], source="upload", scenario=body)
 
 
 @router.get("/scenarios", response_model=list[ScenarioRecord])
 def list_scenarios(request: Request) -> list[dict]:
-    return request.app.state.store.scenarios()
+    """Every scenario: the bundled library first (read-only, named by their names), then the
+    stored ones in the order they were posted."""
+    library = [_library_record(name) for name in planner.scenario_names()]
+    return library + request.app.state.store.scenarios()
 
 
 @router.get("/scenarios/{scenario_id}", response_model=ScenarioRecord)
@@ -70,6 +83,10 @@ def get_scenario(request: Request, scenario_id: str) -> dict:
 
 @router.delete("/scenarios/{scenario_id}", status_code=204)
 def delete_scenario(request: Request, scenario_id: str) -> Response:
+    """Delete a stored scenario (bundled ones are read-only: 403)."""
+    if scenario_id in planner.scenario_names():
+        raise HTTPException(403, f"{scenario_id!r} is a bundled scenario; only stored ones can "
+                                 "be deleted")
     if not request.app.state.store.delete_scenario(scenario_id):
         raise HTTPException(404, f"no scenario {scenario_id!r}")
     return Response(status_code=204)

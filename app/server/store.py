@@ -182,4 +182,5 @@ class Store:
 
 
 def _scenario(row: dict) -> dict:
-    return {"id": row["id"], "name": row["name"], "scenario": json.loads(row["body"])}
+    return {"id": row["id"], "name": row["name"], "source": "upload",
+            "scenario": json.loads(row["body"])}

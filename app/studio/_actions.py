@@ -244,14 +244,17 @@ def _save_to_server(s) -> None:
 
 
 def _load_from_server(s) -> None:
-    """The newest stored scenario whose id or name is the Name field."""
+    """The newest scenario whose id or name is the Name field: a bundled one (slalom, crossing,
+    …) or one saved to the server."""
     name = s.ui.scenario_name.value
     try:
         r = httpx.get(f"{s.api_url}/scenarios", timeout=10.0)
         r.raise_for_status()
-        found = [rec for rec in r.json() if name in (rec["id"], rec["name"])]
+        records = r.json()
+        found = [rec for rec in records if name in (rec["id"], rec["name"])]
         if not found:
-            raise ValueError(f"no stored scenario with id or name '{name}'")
+            bundled = ", ".join(rec["id"] for rec in records if rec["source"] == "library")
+            raise ValueError(f"no scenario with id or name '{name}' (bundled: {bundled})")
         load_scenario(s, found[-1]["scenario"])
     except (httpx.HTTPError, KeyError, ValueError) as exc:
         s.notify("Not loaded", f"scenario '{name}' from the server: {exc}")

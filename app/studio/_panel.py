@@ -96,7 +96,9 @@ def build_panel(gui) -> Panel:
         scene_time = gui.add_slider("Scene time (s)", 0.0, 30.0, 0.1, 0.0)
         play = gui.add_checkbox("Play scene time", False)
     with gui.add_folder("Scenario", expand_by_default=False):
-        scenario_name = gui.add_text("Name", "studio")
+        scenario_name = gui.add_text(
+            "Name", "studio", hint="Save and load by this name; load a bundled scenario by its "
+                                   "name (slalom, crossing, hallway, …)")
         scenario_download = gui.add_button("Download scenario (JSON)")
         scenario_upload = gui.add_upload_button("Upload scenario (JSON)", mime_type=".json")
         scenario_save = gui.add_button("Save to server")

@@ -1,9 +1,11 @@
 """Plot a behaviour run's logged path over its scene, coloured by the machine's state.
 
-    trackstar simulate ../shared/scenarios/hallway.json --behaviour examples/fsm/hallway.json \\
+    trackstar simulate hallway --behaviour examples/fsm/hallway.json \\
         --fixed-latency 20 --json --log run.csv > run.json
-    python examples/fsm/plot_run.py ../shared/scenarios/hallway.json examples/fsm/hallway.json \\
+    python examples/fsm/plot_run.py hallway examples/fsm/hallway.json \\
         run.csv run.json docs/img/fsm_hallway.png
+
+The scenario is a bundled scenario's name or a scenario file.
 
 Approach points are drawn with their tolerance circles, transitions as ticks on the path, the
 goal region in green. FORMAT.md scenes (circles, polygons) only; needs matplotlib.
@@ -22,6 +24,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from matplotlib.patches import Circle, Polygon, Rectangle
 
+import planner
+
 
 def _approach_points(ax, machine: dict, prefix: str = "") -> None:
     for st in machine["states"]:
@@ -34,7 +38,9 @@ def _approach_points(ax, machine: dict, prefix: str = "") -> None:
                         textcoords="offset points")
 
 
-def main(scenario_path, fsm_path, log_path, summary_path, out) -> None:
+def main(scenario, fsm_path, log_path, summary_path, out) -> None:
+    scenario_path = (scenario if Path(scenario).is_file()
+                     else planner.bundled_scenario_path(scenario))
     scn, machine, s = (json.loads(Path(p).read_text())
                        for p in (scenario_path, fsm_path, summary_path))
     log = np.genfromtxt(log_path, delimiter=",", names=True)
