@@ -15,7 +15,8 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from app.planning import PositiveFinite, Seed, TrackSource, track_loader
+from app.planning import TrackSource, track_loader
+from planner.options import PositiveFinite, Seed
 
 __all__ = ["MAX_DURATION_S", "SimOptions", "read_progress", "run_simulation"]
 

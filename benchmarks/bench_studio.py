@@ -103,9 +103,9 @@ def main() -> None:
     data = _scenario()
     warm_up()
     problem = planner.compile_problem(planner.parse_scenario(data))
-    settings = planner.PlannerSettings(seed=1)
+    options = planner.PlanOptions(seed=1)
 
-    alone = PlannerWorker(problem, settings, budget=10**9)
+    alone = PlannerWorker(problem, options, budget=10**9)
     base = _time_to(alone, n, marks)
     alone.stop()
 

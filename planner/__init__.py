@@ -4,35 +4,62 @@ Importable without any web dependency. Typical use::
 
     import planner
     scenario = planner.load_scenario("slalom")   # a bundled name or a scenario file
-    result = planner.solve(scenario, algorithm="rrtstar", time_limit=1.0, seed=0)
+    result = planner.solve(scenario, planner="rrtstar", time_limit=1.0, seed=0)
+
+The names below load on first use, so that ``import planner.options`` (the command line's
+options) does not load numba and the compiled kernels.
 """
 
 from __future__ import annotations
 
-from planner.problem import Problem, compile_problem
-from planner.rrt import Planner, PlannerSettings, Result, TreeEvents, TreeSnapshot
-from planner.rrt import solve as _solve_problem
-from planner.scenario import (
-    Scenario,
-    ScenarioError,
-    bundled_scenario_path,
-    load_scenario,
-    parse_scenario,
-    scenario_names,
-    scenario_schema,
-)
+import importlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from planner.options import PlanOptions
+    from planner.problem import Problem, compile_problem
+    from planner.rrt import Planner, Result, TreeEvents, TreeSnapshot
+    from planner.scenario import (
+        Scenario,
+        ScenarioError,
+        bundled_scenario_path,
+        load_scenario,
+        parse_scenario,
+        scenario_names,
+        scenario_schema,
+    )
+
+_HOMES = {
+    "PlanOptions": "options",
+    "Problem": "problem", "compile_problem": "problem",
+    "Planner": "rrt", "Result": "rrt", "TreeEvents": "rrt", "TreeSnapshot": "rrt",
+    "Scenario": "scenario", "ScenarioError": "scenario", "bundled_scenario_path": "scenario",
+    "load_scenario": "scenario", "parse_scenario": "scenario", "scenario_names": "scenario",
+    "scenario_schema": "scenario",
+}
 
 __all__ = [
-    "Planner", "PlannerSettings", "Problem", "Result", "Scenario", "ScenarioError",
-    "TreeEvents", "TreeSnapshot", "bundled_scenario_path", "compile_problem", "load_scenario",
+    "PlanOptions", "Planner", "Problem", "Result", "Scenario", "ScenarioError", "TreeEvents",
+    "TreeSnapshot", "bundled_scenario_path", "compile_problem", "load_scenario",
     "parse_scenario", "scenario_names", "scenario_schema", "solve",
 ]
 
 
+def __getattr__(name: str):
+    if name not in _HOMES:
+        raise AttributeError(f"module 'planner' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"planner.{_HOMES[name]}"), name)
+    globals()[name] = value
+    return value
+
+
 def solve(scenario: Scenario | Problem, *, time_limit: float | None = 1.0,
-          iterations: int | None = None, planner: str | None = None, **settings) -> Result:
-    """Plan a scenario (or compiled problem). ``planner`` is an alias of ``algorithm``."""
+          iterations: int | None = None, **options) -> Result:
+    """Plan a scenario (or compiled problem) once: ``options`` are `PlanOptions` fields
+    (``planner="rrt"``, ``steering="reeds-shepp"``, ``seed=3``, …)."""
+    from planner.options import PlanOptions
+    from planner.problem import Problem, compile_problem
+    from planner.rrt import Planner
+
     problem = scenario if isinstance(scenario, Problem) else compile_problem(scenario)
-    if planner is not None:
-        settings["algorithm"] = planner
-    return _solve_problem(problem, time_limit=time_limit, iterations=iterations, **settings)
+    return Planner(problem, PlanOptions(**options)).solve(time_limit, iterations)

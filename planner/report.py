@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 from pydantic import BaseModel, Field
@@ -43,7 +42,6 @@ def plan_report(result: Result, scenario_name: str, budget: dict) -> PlanReport:
     """Build the report; ``budget`` holds the time/iteration limits the run was given."""
     columns = [0, 1, 2, 5] if result.timed else [0, 1, 2]
     path = result.path[:, columns].round(6).tolist() if result.solved else []
-    settings = dataclasses.asdict(result.settings)
     return PlanReport(
         scenario=scenario_name, solved=result.solved, cost=_clean(result.cost),
         time_to_first_solution_s=_clean(result.time_to_first_solution_s),
@@ -54,5 +52,6 @@ def plan_report(result: Result, scenario_name: str, budget: dict) -> PlanReport:
         planning_time_s=result.planning_time_s, rewires=result.rewires,
         refused_rewires=result.refused_rewires,
         cost_over_time=[(round(t, 6), c) for t, c in result.cost_over_time], path=path,
-        parameters={**settings, **budget, "motion_check": "exact (clearance stepping)"},
+        parameters={**result.options.model_dump(), **budget,
+                    "motion_check": "exact (clearance stepping)"},
     )

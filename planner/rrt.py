@@ -7,7 +7,6 @@ can be observed through listeners that receive the kernel's event records.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -19,59 +18,10 @@ from planner import _kernel as K
 from planner._paths import sample_path
 from planner._rng import seed_state
 from planner._world import path_clearances
+from planner.options import PLANNERS, STEERINGS, PlanOptions
 from planner.problem import Problem
 
-__all__ = ["Planner", "PlannerSettings", "Result", "TreeEvents", "TreeSnapshot", "solve"]
-
-ALGORITHMS = ("rrt", "rrtstar")
-STEERINGS = ("dubins", "reeds-shepp")
-
-
-@dataclass(frozen=True)
-class PlannerSettings:
-    """Every knob of a run. ``None`` means "derive from the problem" (see `resolved`)."""
-
-    algorithm: str = "rrtstar"
-    steering: str = "dubins"
-    eps: float | None = None  # longest extension (m)
-    gamma: float | None = None  # RRT* radius constant
-    k_rrt: float | None = None  # RRT* with k = k_rrt · log n nearest instead of a radius
-    goal_bias: float = 0.05
-    informed: bool | None = None  # default: on for RRT*
-    seed: int = 0
-    speed: float | None = None  # planning speed v (m/s): default the vehicle's
-
-    def __post_init__(self) -> None:
-        if self.algorithm not in ALGORITHMS:
-            raise ValueError(f"unknown planner '{self.algorithm}' (use one of {ALGORITHMS})")
-        if self.steering not in STEERINGS:
-            raise ValueError(f"unknown steering '{self.steering}' (use one of {STEERINGS})")
-        for name in ("eps", "gamma", "k_rrt", "speed"):
-            v = getattr(self, name)
-            if v is not None and not (math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be a finite number > 0, got {v}")
-        if not 0.0 <= self.goal_bias < 1.0:
-            raise ValueError(f"goal_bias must be in [0, 1), got {self.goal_bias}")
-
-    def resolved(self, problem: Problem) -> PlannerSettings:
-        """Fill the derived defaults: ε from the workspace size, γ from the free space."""
-        xmin, ymin, xmax, ymax = problem.bounds
-        diag = math.hypot(xmax - xmin, ymax - ymin)
-        eps = self.eps if self.eps is not None else max(0.15 * diag, 2.0 * problem.rho)
-        if self.gamma is not None:
-            gamma = self.gamma
-        else:
-            # γ* = (2 (1 + 1/d) μ(X_free) / ζ_d)^(1/d) with d = 3, μ = free area · 2π,
-            # ζ_3 = 4π/3 (Karaman & Frazzoli; OMPL takes the bounds' area, not knowing the free
-            # one, and 1.1 γ*). We take 2.4 γ*: at our iteration rates log(n)/n shrinks the
-            # radius to a fraction of a turning circle within milliseconds, and short rewiring
-            # radii cannot straighten a loop (benchmarks/results/planner.md: cost after 1 s).
-            measure = max(problem.free_area, 1e-9) * 2.0 * math.pi
-            gamma = 2.4 * (2.0 * (4.0 / 3.0) * measure / (4.0 * math.pi / 3.0)) ** (1.0 / 3.0)
-        informed = self.informed if self.informed is not None else self.algorithm == "rrtstar"
-        speed = self.speed if self.speed is not None else problem.speed
-        return dataclasses.replace(self, eps=eps, gamma=gamma, informed=informed, speed=speed)
-
+__all__ = ["Planner", "Result", "TreeEvents", "TreeSnapshot", "warm_up"]
 
 @dataclass
 class Result:
@@ -92,7 +42,7 @@ class Result:
     cost_over_time: list[tuple[float, float]]
     path: np.ndarray  # (n, 6): x, y, theta, curvature, direction, t
     timed: bool
-    settings: PlannerSettings
+    options: PlanOptions  # as resolved for the problem
 
     def cost_at(self, t: float) -> float | None:
         """Best cost found within the first ``t`` seconds, or None."""
@@ -135,11 +85,11 @@ class _Clock:
 class Planner:
     """An RRT / RRT* run on one problem. Not thread-safe: drive it from one thread."""
 
-    def __init__(self, problem: Problem, settings: PlannerSettings | None = None,
+    def __init__(self, problem: Problem, options: PlanOptions | None = None,
                  capacity: int = 4096) -> None:
         self.problem = problem
-        self.settings = (settings or PlannerSettings()).resolved(problem)
-        s = self.settings
+        self.options = (options or PlanOptions()).resolved(problem)
+        s = self.options
         xmin, ymin, xmax, ymax = problem.bounds
         diag = math.hypot(xmax - xmin, ymax - ymin)
         cell = min(max(s.eps / 10.0, diag / 400.0), diag / 8.0)
@@ -154,7 +104,7 @@ class Planner:
         P[K.GX], P[K.GY], P[K.GTH] = problem.goal
         P[K.GPOS], P[K.GHEAD] = problem.goal_position_tol, problem.goal_heading_tol
         P[K.INFORMED] = float(s.informed)
-        P[K.STAR] = float(s.algorithm == "rrtstar")
+        P[K.STAR] = float(s.planner == "rrtstar")
         P[K.REVERSE] = float(s.steering == "reeds-shepp")
         P[K.SX], P[K.SY] = problem.start[:2]
         P[K.K_RRT] = s.k_rrt or 0.0
@@ -222,7 +172,7 @@ class Planner:
     @property
     def finished(self) -> bool:
         """RRT is done at its first solution; RRT* goes on improving."""
-        return self.settings.algorithm == "rrt" and self.solved
+        return self.options.planner == "rrt" and self.solved
 
     def snapshot(self) -> TreeSnapshot:
         n = self.nodes
@@ -310,7 +260,7 @@ class Planner:
             parts.append(seg[1:])
         pts = np.vstack(parts)
         driven = np.concatenate([[0.0], np.cumsum(_step_lengths(pts))])
-        return np.column_stack([pts, driven / self.settings.speed])
+        return np.column_stack([pts, driven / self.options.speed])
 
     def result(self) -> Result:
         t = self._tree
@@ -328,7 +278,7 @@ class Planner:
             planning_time_s=self._compute_time, min_clearance_m=min_clear,
             max_abs_curvature=float(np.abs(path[:, 3]).max()) if solved else None,
             cost_over_time=list(self._clock.cost_over_time), path=path,
-            timed=self.problem.timed, settings=self.settings)
+            timed=self.problem.timed, options=self.options)
 
 
 def _step_lengths(pts: np.ndarray) -> np.ndarray:
@@ -353,15 +303,9 @@ def warm_up() -> None:
     world = build_world((0, 0, 10, 10), 0.1, [(5, 5, 1, -1)], [([(1, 1), (2, 1), (2, 2)], 0)],
                         [("velocity", (0.1, 0))])
     problem = Problem(None, world, (0.5, 0.5, 0.0), (9, 9, 0.0), 0.5, 0.5, 1.0, 1.0, True)
-    for algorithm in ALGORITHMS:
+    for name in PLANNERS:
         for steering in STEERINGS:
-            p = Planner(problem, PlannerSettings(algorithm=algorithm, steering=steering))
+            p = Planner(problem, PlanOptions(planner=name, steering=steering))
             p.step(40)
             p.result()
     _warm = True
-
-
-def solve(problem: Problem, *, time_limit: float | None = 1.0, iterations: int | None = None,
-          **settings) -> Result:
-    """Plan once: ``solve(problem, algorithm="rrtstar", steering="dubins", seed=0, …)``."""
-    return Planner(problem, PlannerSettings(**settings)).solve(time_limit, iterations)

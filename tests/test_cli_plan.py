@@ -20,7 +20,7 @@ def test_plan_prints_one_json_object_with_the_contract_keys():
                 "collision_checks", "min_clearance_m", "path", "parameters"):
         assert key in data
     assert data["solved"] and all(len(p) == 3 for p in data["path"])
-    assert data["parameters"]["algorithm"] == "rrtstar" and data["parameters"]["time"] == 0.5
+    assert data["parameters"]["planner"] == "rrtstar" and data["parameters"]["time"] == 0.5
     assert data["parameters"]["seed"] == 0 and data["parameters"]["eps"] > 0
 
 
@@ -29,7 +29,7 @@ def test_plan_with_iterations_is_reproducible_and_echoes_options():
             "--seed", "3", "--planner", "rrt", "--steering", "dubins")
     a, b = json.loads(run(*args).stdout), json.loads(run(*args).stdout)
     assert a["path"] == b["path"] and a["iterations"] == b["iterations"]
-    assert a["parameters"]["algorithm"] == "rrt" and a["parameters"]["iterations"] == 800
+    assert a["parameters"]["planner"] == "rrt" and a["parameters"]["iterations"] == 800
     assert a["parameters"]["time"] is None
 
 
@@ -84,8 +84,9 @@ def test_bad_input_exits_2_with_one_line_quickly(tmp_path, content, message):
 @pytest.mark.parametrize("args, words", [
     (("plan", "slalom", "--planner", "prm"), "'--planner'"),
     (("plan", "slalom", "--steering", "foo"), "'foo' is not one of"),
-    (("plan", "slalom", "--time", "-1"), "--time must be > 0"),
-    (("plan", "slalom", "--iterations", "0"), "'--iterations'"),
+    (("plan", "slalom", "--time", "-1"), "--time: Input should be greater than 0"),
+    (("plan", "slalom", "--goal-bias", "1.5"), "--goal-bias: Input should be less than 1"),
+    (("plan", "slalom", "--iterations", "0"), "--iterations: Input should be greater than or equal to 1"),
     (("plan",), "Missing argument"),
     (("plan", "slalom", "--bogus"), "No such option: --bogus"),
     (("nonsense",), "No such command"),
@@ -99,7 +100,7 @@ def test_usage_errors_exit_2_with_one_line(args, words):
 
 def test_help_keeps_bracketed_defaults_and_units():
     plan = run("plan", "--help").stdout
-    assert "[default: 1.0, or none when --iterations is given]" in " ".join(plan.split())
+    assert "[default: 1.0, or none when an iteration budget is given]" in " ".join(plan.split())
     sample = " ".join(run("track", "sample", "--help").stdout.split())
     assert "[m]" in sample and "Wheelbase L [m]" in sample
 

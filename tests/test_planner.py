@@ -62,12 +62,12 @@ def test_rrtstar_cost_never_increases():
 
 def test_rrtstar_beats_rrt_on_average_over_seeds():
     star = [plan("slalom", iterations=3000, seed=s).cost for s in range(4)]
-    rrt = [plan("slalom", iterations=3000, seed=s, algorithm="rrt").cost for s in range(4)]
+    rrt = [plan("slalom", iterations=3000, seed=s, planner="rrt").cost for s in range(4)]
     assert np.mean(star) < np.mean(rrt)
 
 
 def test_rrt_stops_at_its_first_solution():
-    result = plan("open_field", iterations=20000, algorithm="rrt")
+    result = plan("open_field", iterations=20000, planner="rrt")
     assert result.solved and result.iterations < 20000
     assert len(result.cost_over_time) == 1
 
@@ -123,7 +123,7 @@ def test_k_nearest_variant_finds_valid_paths_and_rewires():
     result = plan("slalom", iterations=3000, k_rrt=5.5)
     assert result.solved and result.rewires > 0
     assert first_collision(scenario_dict("slalom"), result.path[:, :3]) is None
-    assert result.settings.k_rrt == 5.5
+    assert result.options.k_rrt == 5.5
 
 
 def test_live_poses_are_a_read_only_view_and_the_root_edge_is_a_dot():
@@ -139,13 +139,13 @@ def test_live_poses_are_a_read_only_view_and_the_root_edge_is_a_dot():
 @pytest.mark.parametrize("name", ["hallway", "oval_track"])
 def test_nearest_is_the_true_nearest_by_steering_length(name, steering):
     """The pruned best-first search returns what a scan of every node returns (OMPL's way)."""
+    from planner import Planner, PlanOptions
     from planner import _kernel as K
     from planner._dubins import dubins_length
     from planner._reeds_shepp import reeds_shepp_length
-    from planner.rrt import Planner, PlannerSettings
 
     problem = planner.compile_problem(planner.parse_scenario(scenario_dict(name)))
-    run = Planner(problem, PlannerSettings(steering=steering, seed=3))
+    run = Planner(problem, PlanOptions(steering=steering, seed=3))
     run.step(3000)
     tree, n = run._tree, run.nodes
     length = dubins_length if steering == "dubins" else reeds_shepp_length

@@ -222,6 +222,22 @@ def test_plan_is_the_cli_plan_json(server):
     assert report["parameters"]["time"] == 3  # iterations only: the server's cap still holds
 
 
+def test_the_plan_body_has_the_options_of_trackstar_plan_with_the_same_defaults(server):
+    spec = server.get("/openapi.json").json()["components"]["schemas"]["PlanRequest"]
+    api = {name: field.get("default") for name, field in spec["properties"].items()
+           if name not in ("scenario", "scenario_id")}
+    helped = subprocess.run(["trackstar", "plan", "--help"], capture_output=True, text=True,
+                            check=True).stdout
+    cli = set(re.findall(r"^  --([a-z][a-z-]*)", helped, re.MULTILINE)) - {"json", "help"}
+    assert cli == {name.replace("_", "-") for name in api}
+    # The defaults a run without options uses: the CLI's echo of them is the API's schema.
+    ran = json.loads(subprocess.run(["trackstar", "plan", "slalom", "--iterations", "50",
+                                     "--json"], capture_output=True, text=True,
+                                    check=True).stdout)["parameters"]
+    for name in ("planner", "steering", "seed", "goal_bias", "k_rrt"):
+        assert ran[name] == api[name], name
+
+
 def test_plan_by_id_on_an_uploaded_track(server):
     track = upload(server, TWO_PATHS, path="loop", unit="m").json()  # 30 m square, 4 m wide
     scenario = {"name": "square", "track": {"name": track["id"]},

@@ -27,7 +27,7 @@ def test_job_runs_every_combination(server):
     assert created.status_code == 202 and created.json()["total"] == 8
     job = server.wait_job(created.json()["id"])
     assert job["status"] == "done" and job["done"] == job["total"] == 8
-    runs = {(r["scenario"], r["parameters"]["algorithm"], r["seed"]) for r in job["results"]}
+    runs = {(r["scenario"], r["parameters"]["planner"], r["seed"]) for r in job["results"]}
     assert runs == {(s, a, seed) for s in ("slalom", "open_field") for a in ("rrtstar", "rrt")
                     for seed in (0, 1)}
     assert all("path" not in r and r["iterations"] >= 1 for r in job["results"])
@@ -35,15 +35,15 @@ def test_job_runs_every_combination(server):
     single = server.client.post("/plan", json={"scenario_id": stored, "iterations": 300,
                                                "seed": 1}).json()
     twin = next(r for r in job["results"] if r["scenario"] == "slalom" and r["seed"] == 1
-                and r["parameters"]["algorithm"] == "rrtstar")
+                and r["parameters"]["planner"] == "rrtstar")
     assert twin["cost"] == single["cost"] and twin["nodes"] == single["nodes"]
 
     table = server.client.get(f"/jobs/{job['id']}/results.csv")
     assert table.headers["content-type"].startswith("text/csv")
     rows = list(csv.DictReader(io.StringIO(table.text)))
     assert len(rows) == 8
-    assert {"scenario", "seed", "cost", "solved", "parameters.algorithm"} <= rows[0].keys()
-    assert {r["parameters.algorithm"] for r in rows} == {"rrt", "rrtstar"}
+    assert {"scenario", "seed", "cost", "solved", "parameters.planner"} <= rows[0].keys()
+    assert {r["parameters.planner"] for r in rows} == {"rrt", "rrtstar"}
 
 
 def test_cancel_keeps_finished_results_and_stays_cancelled(server):

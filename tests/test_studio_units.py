@@ -38,7 +38,7 @@ def test_default_scenario_starts_on_the_track_heading_along_it(name):
 
 
 def test_edge_points_run_from_parent_to_node_along_the_tree():
-    run = planner.Planner(_problem(), planner.PlannerSettings(seed=3))
+    run = planner.Planner(_problem(), planner.PlanOptions(seed=3))
     run.step(300)
     snap = run.snapshot()
     for node in range(1, run.nodes):
@@ -85,7 +85,7 @@ def test_chunk_messages_stay_the_same_size_however_big_the_tree():
 
 def test_extend_explains_what_each_iteration_really_did():
     """Every iteration of a real RRT* run maps to the line its event record implies."""
-    run = planner.Planner(_problem(), planner.PlannerSettings(seed=5))
+    run = planner.Planner(_problem(), planner.PlanOptions(seed=5))
     seen = set()
     events = []
     run.add_listener(events.append)
@@ -180,7 +180,7 @@ def test_a_run_that_ends_between_metric_updates_still_shows_its_last_numbers():
 
     from app.studio._worker import PlannerWorker
 
-    worker = PlannerWorker(_problem(), planner.PlannerSettings(seed=0), budget=300)
+    worker = PlannerWorker(_problem(), planner.PlanOptions(seed=0), budget=300)
     try:
         worker.run()
         deadline = time.monotonic() + 10

@@ -3,24 +3,14 @@
 from __future__ import annotations
 
 import json
-from enum import Enum
 from typing import Annotated
 
 import typer
 
 from app.cli._errors import user_errors
+from app.cli._options import model_options
 from app.cli._warm import warm_kernels
-
-
-class Algorithm(str, Enum):
-    rrt = "rrt"
-    rrtstar = "rrtstar"
-
-
-class Steering(str, Enum):
-    dubins = "dubins"
-    reeds_shepp = "reeds-shepp"
-
+from planner.options import PlanOptions
 
 scenario_cli = typer.Typer(help="Scenarios: the bundled ones, validation and the schema.",
                            no_args_is_help=True, rich_markup_mode=None)
@@ -30,36 +20,17 @@ ScenarioArg = Annotated[str, typer.Argument(
                              "JSON file (FORMAT.md or the rich schema).")]
 
 
+@model_options(PlanOptions)
 def plan(
     scenario: ScenarioArg,
-    planner: Annotated[Algorithm, typer.Option(help="Planning algorithm.")] = Algorithm.rrtstar,
-    steering: Annotated[Steering, typer.Option(help="Car steering.")] = Steering.dubins,
-    time: Annotated[float | None, typer.Option(help="Time budget in seconds [default: 1.0, "
-                                                    "or none when --iterations is given].")] = None,
-    iterations: Annotated[int | None, typer.Option(min=1, help="Iteration budget.")] = None,
-    seed: Annotated[int, typer.Option(help="Random seed: same seed, same tree.")] = 0,
-    eps: Annotated[float | None, typer.Option(help="Longest extension ε (m).")] = None,
-    gamma: Annotated[float | None, typer.Option(help="RRT* radius constant γ.")] = None,
-    k_rrt: Annotated[float | None, typer.Option(help="RRT* with the k = k_rrt·log n nearest "
-                                                     "instead of a radius (OMPL: 5.5).")] = None,
-    goal_bias: Annotated[float, typer.Option(help="Probability of sampling the goal.")] = 0.05,
-    informed: Annotated[bool | None, typer.Option(help="Informed sampling after the first "
-                                                       "solution [default: on for RRT*].")] = None,
-    speed: Annotated[float | None, typer.Option(help="Planning speed v (m/s) [default: the "
-                                                     "scenario's vehicle.speed].")] = None,
+    options: PlanOptions,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Plan a path for the car from start to goal with RRT or RRT*."""
     import planner as core
-    from app.planning import PlanOptions, run_plan
+    from app.planning import run_plan
 
     with user_errors():
-        if time is not None and not time > 0:
-            raise ValueError(f"--time must be > 0, got {time}")
-        options = PlanOptions(
-            planner=planner.value, steering=steering.value, time=time, iterations=iterations,
-            seed=seed, eps=eps, gamma=gamma, k_rrt=k_rrt, goal_bias=goal_bias,
-            informed=informed, speed=speed)
         scenario_model = core.load_scenario(scenario)
         warm_kernels()
         report = run_plan(scenario_model, options)
@@ -71,14 +42,14 @@ def plan(
 
 def _print_summary(report) -> None:
     p = report.parameters
-    typer.echo(f"{report.scenario}: {p['algorithm']} with {p['steering']} steering, seed {p['seed']}")
+    typer.echo(f"{report.scenario}: {p['planner']} with {p['steering']} steering, seed {p['seed']}")
     if not report.solved:
         typer.echo(f"  not solved within the budget ({report.iterations} iterations, "
                    f"{report.nodes} nodes)")
         return
     typer.echo(f"  cost {report.cost:.3f} m, first solution after "
                f"{1000 * report.time_to_first_solution_s:.1f} ms")
-    stop = " (RRT stops at its first solution; RRT* improves it)" if p["algorithm"] == "rrt" else ""
+    stop = " (RRT stops at its first solution; RRT* improves it)" if p["planner"] == "rrt" else ""
     typer.echo(f"  {report.iterations} iterations{stop}, {report.nodes} nodes, "
                f"{report.collision_checks} motion checks, {report.rewires} rewires")
     typer.echo(f"  min clearance {report.min_clearance_m:.3f} m, "

@@ -20,9 +20,10 @@ from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
-from app.planning import PlanOptions, TrackSource, check_scenario, run_plan
+from app.planning import TrackSource, check_scenario, run_plan
 from app.server.store import Store
 from app.simulation import SimOptions, read_progress, run_simulation
+from planner.options import PlanOptions
 from planner.report import PlanReport
 from planner.rrt import warm_up
 

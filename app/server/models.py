@@ -1,7 +1,7 @@
 """Bodies and responses of the REST API: one pydantic model each, so /docs shows them all.
 
 Plan results are `planner.report.PlanReport`, the model `trackstar plan --json` prints; the
-planning options are `app.planning.PlanOptions`, the CLI's options.
+planning options are `planner.PlanOptions`, from which the CLI's options are generated.
 """
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from app.planning import PlanOptions, Seed
 from app.simulation import SimOptions
+from planner.options import PlanOptions, Seed
 from planner.report import PlanReport
 
 Point = tuple[float, float]

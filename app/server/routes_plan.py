@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from fastapi import APIRouter, HTTPException, Request
 
-from app.planning import PlanOptions
 from app.server.models import PlanRequest
 from app.server.routes_scenarios import resolve
+from planner.options import PlanOptions
 from planner.report import PlanReport
 
 router = APIRouter(tags=["planning"])

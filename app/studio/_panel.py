@@ -7,9 +7,9 @@ from dataclasses import dataclass
 import tracks
 from app.studio._extend import render
 
-__all__ = ["ALGORITHMS", "MOTIONS", "SPEEDS", "STEERINGS", "Panel", "build_panel"]
+__all__ = ["MOTIONS", "PLANNERS", "SPEEDS", "STEERINGS", "Panel", "build_panel"]
 
-ALGORITHMS = {"RRT*": "rrtstar", "RRT": "rrt"}
+PLANNERS = {"RRT*": "rrtstar", "RRT": "rrt"}
 STEERINGS = {"Dubins": "dubins", "Reeds-Shepp": "reeds-shepp"}
 MOTIONS = ("static", "velocity", "waypoints", "follow track")
 SPEEDS = {"max": None, "2000 it/s": 2000.0, "200 it/s": 200.0, "20 it/s": 20.0}
@@ -47,7 +47,7 @@ class Panel:
     scenario_save: object
     scenario_load: object
     scenario_name: object
-    algorithm: object
+    planner: object
     steering: object
     eps: object
     gamma: object
@@ -104,7 +104,7 @@ def build_panel(gui) -> Panel:
         scenario_save = gui.add_button("Save to server")
         scenario_load = gui.add_button("Load from server")
     with gui.add_folder("Planner"):
-        algorithm = gui.add_dropdown("Algorithm", tuple(ALGORITHMS), initial_value="RRT*")
+        planner = gui.add_dropdown("Planner", tuple(PLANNERS), initial_value="RRT*")
         steering = gui.add_dropdown("Steering", tuple(STEERINGS), initial_value="Dubins")
         eps = gui.add_number("ε (m, 0 = auto)", 0.0, min=0.0, step=0.05)
         gamma = gui.add_number("γ (0 = auto)", 0.0, min=0.0, step=0.5)
@@ -112,7 +112,8 @@ def build_panel(gui) -> Panel:
         goal_bias = gui.add_slider("Goal bias", 0.0, 0.5, 0.01, 0.05)
         budget = gui.add_number("Budget (iterations)", 30000, min=1, step=1000)
         seed = gui.add_number("Seed", 0, min=0, step=1)
-        speed_v = gui.add_number("v (m/s)", 1.0, min=0.05, step=0.1)
+        speed_v = gui.add_number("v (m/s, 0 = scenario's)", 0.0, min=0.0, step=0.1,
+                                 hint="Planning speed; 0 plans at the scenario's vehicle.speed")
         rate = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="max")
         run = gui.add_button("Run")
         pause = gui.add_button("Pause")

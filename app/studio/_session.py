@@ -22,7 +22,7 @@ from app.studio._custom import Draft
 from app.studio._edit import place_gizmos
 from app.studio._extend import explain, render
 from app.studio._live_view import LiveView
-from app.studio._panel import ALGORITHMS, SPEEDS, STEERINGS, build_panel
+from app.studio._panel import PLANNERS, SPEEDS, STEERINGS, build_panel
 from app.studio._plots import Profiles
 from app.studio._scenario import default_scenario, goal_fraction
 from app.studio._scene import (
@@ -187,10 +187,11 @@ class Session:
                           indent=2)
 
     # -- planner -------------------------------------------------------------------------------
-    def settings(self) -> planner.PlannerSettings:
+    def options(self) -> planner.PlanOptions:
+        """The planner panel as `PlanOptions`: 0 in a number field means "derived"."""
         u = self.ui
-        return planner.PlannerSettings(
-            algorithm=ALGORITHMS[u.algorithm.value], steering=STEERINGS[u.steering.value],
+        return planner.PlanOptions(
+            planner=PLANNERS[u.planner.value], steering=STEERINGS[u.steering.value],
             eps=u.eps.value or None, gamma=u.gamma.value or None, k_rrt=u.k_rrt.value or None,
             goal_bias=float(u.goal_bias.value), seed=int(u.seed.value),
             speed=u.speed_v.value or None)
@@ -203,11 +204,11 @@ class Session:
             if self.view is not None:
                 self.view.clear()
             try:
-                settings = self.settings()
+                options = self.options()
             except ValueError as exc:
-                self.notify("Planner settings", str(exc))
-                settings = planner.PlannerSettings()
-            self.worker = PlannerWorker(self.problem, settings, int(self.ui.budget.value),
+                self.notify("Planner options", str(exc))
+                options = planner.PlanOptions()
+            self.worker = PlannerWorker(self.problem, options, int(self.ui.budget.value),
                                         SPEEDS[self.ui.rate.value])
             self.view = LiveView(self.scene, self.worker.live, self.marker())
             self._shown = {"metrics": -1, "best": 0, "step": 0, "costs": 0}

@@ -47,15 +47,15 @@ class Live:
 class PlannerWorker:
     """Owns a `planner.Planner`; driven by commands (run, pause, step, stop) from the UI."""
 
-    def __init__(self, problem, settings: planner.PlannerSettings, budget: int,
+    def __init__(self, problem, options: planner.PlanOptions, budget: int,
                  rate: float | None = None) -> None:
         self.live = Live()
         self.budget = budget
         self.rate = rate  # iterations per second, None: as fast as it goes
         self._problem = problem
-        self._run = planner.Planner(problem, settings)
+        self._run = planner.Planner(problem, options)
         self._run.add_listener(self._on_events)
-        self._star = settings.algorithm == "rrtstar"
+        self._star = options.planner == "rrtstar"
         self._cmds: queue.Queue[str] = queue.Queue()
         self._stepping = False
         self._best = None

@@ -20,8 +20,9 @@ import numpy as np
 from planner import _kernel as K
 from planner._paths import pose_at
 from planner._world import clearance, path_clearances
+from planner.options import PlanOptions
 from planner.problem import Problem
-from planner.rrt import Planner, PlannerSettings
+from planner.rrt import Planner
 from planner.sim._reroot import reroot
 from planner.sim.control import Reference
 from planner.sim.predict import inflated, predicted_world
@@ -54,11 +55,11 @@ class Cycle:
 class Replanner:
     """The planning side of the car: its tree, its committed trajectory, its budget."""
 
-    def __init__(self, problem: Problem, settings: PlannerSettings, *, seed: int,
+    def __init__(self, problem: Problem, options: PlanOptions, *, seed: int,
                  budget_s: float | None, iterations: int | None, margin: float,
                  horizon_s: float = 4.0) -> None:
         self.problem = problem
-        self.settings = settings.resolved(problem)
+        self.options = options.resolved(problem)
         self.seed = seed
         self.budget_s = budget_s
         self.iterations = iterations
@@ -152,8 +153,8 @@ class Replanner:
             self.problem, world=world, start=tuple(root), timed=True,
             goal_position_tol=GOAL_SHARE * self.problem.goal_position_tol,
             goal_heading_tol=GOAL_SHARE * self.problem.goal_heading_tol)
-        settings = dataclasses.replace(self.settings, seed=self.seed * 1_000_003 + self.count)
-        planner = Planner(problem, settings, capacity=capacity)
+        options = self.options.model_copy(update={"seed": self.seed * 1_000_003 + self.count})
+        planner = Planner(problem, options, capacity=capacity)
         if keep:
             remaining = self._remaining_cost(self._s_c)
             bound = PRUNE_FACTOR * remaining + PRUNE_SLACK if math.isfinite(remaining) else math.inf
@@ -195,7 +196,7 @@ class Replanner:
         if ref is None:
             return 0.0, False
         s_now = max(s_now - self.shift, 0.0)  # in the arcs of the reference just built
-        speed = self.settings.speed
+        speed = self.options.speed
         i0 = int(np.searchsorted(ref.s, s_now))
         i1 = int(np.searchsorted(ref.s, s_now + speed * self.horizon_s))
         rows = ref.rows[i0:i1 + 1]
@@ -223,9 +224,9 @@ def warm_up() -> None:
 
     world = build_world((0, 0, 10, 10), 0.1, [(5, 5, 1, 0)], [], [("velocity", (0.1, 0))])
     problem = Problem(None, world, (0.5, 0.5, 0.0), (9, 9, 0.0), 0.5, 0.5, 1.0, 1.0, True)
-    old = Planner(problem, PlannerSettings())
+    old = Planner(problem, PlanOptions())
     old.step(40)
-    new = Planner(problem, PlannerSettings())
+    new = Planner(problem, PlanOptions())
     reroot(old._tree, new._tree, world, new._P, 0, 0.0, math.inf)
     pose_at(0.0, 0.0, 0.0, old._tree.kinds[1], old._tree.lens[1], 1.0, 0.1)
     _warm = True

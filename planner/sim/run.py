@@ -17,8 +17,9 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from planner._world import path_clearances
+from planner.options import PlanOptions
 from planner.problem import Problem, compile_problem, resolve_track
-from planner.rrt import Planner, PlannerSettings, warm_up
+from planner.rrt import Planner, warm_up
 from planner.scenario import Scenario
 from planner.sim.control import CONTROLLERS, Reference, Tracking, steer_command
 from planner.sim.fsm import Machine
@@ -148,7 +149,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     rng = np.random.default_rng(s.seed)
     fixed = s.fixed_latency_ms / 1000.0 if s.fixed_latency_ms is not None else None
     def new_replanner() -> Replanner:
-        return Replanner(problem, PlannerSettings(seed=s.seed), seed=s.seed,
+        return Replanner(problem, PlanOptions(seed=s.seed), seed=s.seed,
                          budget_s=s.budget_share / s.rate,
                          iterations=s.iterations if fixed is not None else None,
                          margin=s.margin)

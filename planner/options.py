@@ -1,0 +1,85 @@
+"""How to plan: the one description of a run's options.
+
+`PlanOptions` is what the planner takes, what `trackstar plan` generates its options from (names,
+defaults, help), what the REST API's plan and job bodies are made of and what the studio's
+planner panel fills. ``None`` means "derived from the problem" (`resolved` fills it in).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+__all__ = ["PLANNERS", "STEERINGS", "PlanOptions", "PositiveFinite", "Seed"]
+
+PLANNERS = ("rrt", "rrtstar")
+STEERINGS = ("dubins", "reeds-shepp")
+DEFAULT_TIME_S = 1.0
+
+PositiveFinite = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Seed = Annotated[int, Field(ge=0, lt=2**64)]
+
+
+class PlanOptions(BaseModel):
+    """Every option of a planning run, with its default; the budget (time, iterations) too."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    planner: Literal["rrt", "rrtstar"] = Field(
+        "rrtstar", description="Planning algorithm: RRT stops at its first solution, RRT* "
+                               "goes on improving it.")
+    steering: Literal["dubins", "reeds-shepp"] = Field(
+        "dubins", description="Car steering: Dubins drives forward only, Reeds-Shepp reverses "
+                              "too.")
+    time: PositiveFinite | None = Field(
+        None, description="Time budget in seconds [default: 1.0, or none when an iteration "
+                          "budget is given].")
+    iterations: Annotated[int, Field(ge=1)] | None = Field(None, description="Iteration budget.")
+    seed: Seed = Field(0, description="Random seed: same seed, same tree.")
+    eps: PositiveFinite | None = Field(
+        None, description="Longest extension ε [m] [default: 15 % of the workspace diagonal, "
+                          "at least two turning radii].")
+    gamma: PositiveFinite | None = Field(
+        None, description="RRT* radius constant γ [default: 2.4 γ* of the free space].")
+    k_rrt: PositiveFinite | None = Field(
+        None, description="RRT* with the k = k_rrt·log n nearest instead of a radius "
+                          "(OMPL: 5.5).")
+    goal_bias: Annotated[float, Field(ge=0, lt=1)] = Field(
+        0.05, description="Probability of sampling the goal.")
+    informed: bool | None = Field(
+        None, description="Informed sampling after the first solution [default: on for RRT*].")
+    speed: PositiveFinite | None = Field(
+        None, description="Planning speed v [m/s] [default: the scenario's vehicle.speed].")
+
+    def time_budget(self, max_time: float | None = None) -> float | None:
+        """The time limit of the run: 1 s by default, none with only iterations; a server's
+        cap ``max_time`` refuses a longer explicit time and bounds the others."""
+        budget = DEFAULT_TIME_S if self.time is None and self.iterations is None else self.time
+        if max_time is None:
+            return budget
+        if self.time is not None and self.time > max_time:
+            raise ValueError(f"time: {self.time} s is above this server's limit of {max_time} s")
+        return max_time if budget is None else min(budget, max_time)
+
+    def resolved(self, problem) -> PlanOptions:
+        """Fill the derived defaults from a `planner.Problem`: ε from the workspace size, γ
+        from the free space, informed sampling and the speed."""
+        xmin, ymin, xmax, ymax = problem.bounds
+        diag = math.hypot(xmax - xmin, ymax - ymin)
+        eps = self.eps if self.eps is not None else max(0.15 * diag, 2.0 * problem.rho)
+        if self.gamma is not None:
+            gamma = self.gamma
+        else:
+            # γ* = (2 (1 + 1/d) μ(X_free) / ζ_d)^(1/d) with d = 3, μ = free area · 2π,
+            # ζ_3 = 4π/3 (Karaman & Frazzoli; OMPL takes the bounds' area, not knowing the free
+            # one, and 1.1 γ*). We take 2.4 γ*: at our iteration rates log(n)/n shrinks the
+            # radius to a fraction of a turning circle within milliseconds, and short rewiring
+            # radii cannot straighten a loop (benchmarks/results/planner.md: cost after 1 s).
+            measure = max(problem.free_area, 1e-9) * 2.0 * math.pi
+            gamma = 2.4 * (2.0 * (4.0 / 3.0) * measure / (4.0 * math.pi / 3.0)) ** (1.0 / 3.0)
+        informed = self.informed if self.informed is not None else self.planner == "rrtstar"
+        speed = self.speed if self.speed is not None else problem.speed
+        return self.model_copy(update={"eps": eps, "gamma": gamma, "informed": informed,
+                                       "speed": speed})
