@@ -15,13 +15,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from planner import _kernel as K
-from planner._paths import sample_path
+from planner._paths import pose_at, sample_path
+from planner._reroot import reroot
 from planner._rng import seed_state
 from planner._world import path_clearances
 from planner.options import PLANNERS, STEERINGS, PlanOptions
 from planner.problem import Problem
 
 __all__ = ["Planner", "Result", "TreeEvents", "TreeSnapshot", "warm_up"]
+
+CLEARANCE_SPACING_M = 0.005  # as FORMAT.md re-checks returned paths
 
 @dataclass
 class Result:
@@ -262,13 +265,61 @@ class Planner:
         driven = np.concatenate([[0.0], np.cumsum(_step_lengths(pts))])
         return np.column_stack([pts, driven / self.options.speed])
 
+    @property
+    def root(self) -> tuple[float, float, float]:
+        """The root's pose (x, y, θ)."""
+        return tuple(float(v) for v in self._tree.pose[0])
+
+    def best_path_at(self, s: float) -> tuple[tuple[float, float, float], int, float]:
+        """Where the best path is ``s`` metres (driven) from the root: (pose, anchor, skip),
+        the anchor being the node whose incoming edge holds the pose and skip how far along
+        that edge it lies (0: the pose is the anchor's own). Past the end: the last node."""
+        t = self._tree
+        chain = self.best_path_nodes()
+        i = int(np.searchsorted(t.cost[chain], s, side="right"))
+        if i >= len(chain):
+            return self._pose(chain[-1]), chain[-1], 0.0
+        node, parent = chain[i], chain[i - 1]
+        skip = s - t.cost[parent]
+        if skip <= 1e-12:
+            return self._pose(parent), parent, 0.0
+        x, y, th, _, _ = pose_at(*t.pose[parent], t.kinds[node], t.lens[node], self.problem.rho,
+                                 skip)
+        return (x, y, th), node, float(skip)
+
+    def _pose(self, node: int) -> tuple[float, float, float]:
+        return tuple(float(v) for v in self._tree.pose[node])
+
+    def adopt(self, old: Planner, anchor: int, skip: float, bound: float = math.inf) -> int:
+        """Take over the still-valid part of ``old``'s tree (replanning: keep the tree).
+
+        This planner holds only its root, which is the state ``skip`` metres along ``old``'s
+        edge into ``anchor`` (skip 0: ``anchor`` itself). The subtree ahead of it is copied
+        with its edges unchanged and its costs shifted; each edge is re-checked in this
+        planner's world at its new arrival time and dropped, with what hangs below it, if it
+        collides; nodes whose cost plus distance to the goal exceeds ``bound`` are pruned.
+        Returns the number of nodes copied."""
+        if self.nodes != 1:
+            raise ValueError("adopt() needs a planner that holds only its root")
+        if self._tree.pose.shape[0] < old.nodes + 1:
+            self._tree = K.grown(self._tree, 2 * (old.nodes + 1))
+        copied = reroot(old._tree, self._tree, self.problem.world, self._P, anchor, skip, bound)
+        K._update_best(self._tree)
+        return int(copied)
+
+    def best_path_clearance(self) -> float | None:
+        """The least clearance along the best path, in space-time: the one definition of the
+        path metric (checked every 5 mm; None before a solution)."""
+        if not self.solved:
+            return None
+        fine = self.dense_path(CLEARANCE_SPACING_M)
+        return float(path_clearances(self.problem.world, fine, self.problem.timed).min())
+
     def result(self) -> Result:
         t = self._tree
         path = self.dense_path(0.05)
-        fine = self.dense_path(0.005)
         solved = self.solved
-        min_clear = (float(path_clearances(self.problem.world, fine, self.problem.timed).min())
-                     if solved else None)
+        min_clear = self.best_path_clearance()
         return Result(
             solved=solved, cost=self.best_cost,
             time_to_first_solution_s=self._clock.first_solution_s,

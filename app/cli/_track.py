@@ -121,7 +121,7 @@ def plot(
     """Draw the track with its boundaries, and curvature and steering angle over s."""
     with user_errors():
         from tracks import check_sampling
-        from tracks._plot import figure_path, plot_profile
+        from tracks.plot import figure_path, plot_profile
 
         figure_path(output)
         check_sampling(spacing, wheelbase, max_steer_deg)

@@ -21,7 +21,6 @@ import numpy as np
 
 from app.studio._live_view import PATH_RGB, TREE_RGB
 from app.studio._scene import Z, _fill, obstacle_shape, polyline_segments, yaw_wxyz
-from planner._world import pose_clearance
 from planner.sim import SimSettings
 from planner.sim.control import CONTROLLERS
 from planner.sim.run import Frame, simulate
@@ -127,7 +126,8 @@ class _Run:
         self.history.append((f.t, f.steer_set, f.steer, f.lateral_error))
         if f.cycles > len(self.cycle_ms):
             self.cycle_ms.append(f.cycle_ms)
-        self.clearance = pose_clearance(self.problem.world, *f.pose, f.t)
+        x, y, theta = f.pose
+        self.clearance = self.problem.clearance(x, y, f.t, theta)
         self.min_clearance = min(self.min_clearance, self.clearance)
         now = time.monotonic()
         fresh = f.planner is not None and f.planner is not self._tree_of

@@ -19,7 +19,6 @@ import planner
 from app.studio._extend import StepInfo
 from app.studio._tree import SEG, EdgeChunks
 from planner import _kernel as K
-from planner._world import path_clearances
 
 __all__ = ["Live", "PlannerWorker"]
 
@@ -173,8 +172,7 @@ class PlannerWorker:
         if cost is not None and (self._best is None or cost < self._best - 1e-9):
             self._best = cost
             live.best_path = run.dense_path(0.05)
-            self._clearance = float(path_clearances(self._problem.world, live.best_path,
-                                                    self._problem.timed).min())
+            self._clearance = run.best_path_clearance()
             live.best_version += 1
             live.cost_over_time.append((self._wall, cost))
         if now - self._last_metrics >= 0.5 or self._stepping:

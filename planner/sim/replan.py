@@ -2,7 +2,7 @@
 
 The replanner keeps the RRT* tree between cycles. Each cycle commits to the stretch of the
 current trajectory the car will drive before the new plan can arrive, re-roots the tree at the
-end of that stretch (keeping the still-valid subtree ahead, see `_reroot`), grows it for one
+end of that stretch (keeping the still-valid subtree ahead: `Planner.adopt`), grows it for one
 cycle's budget in the world the car believes in (sensed movers at constant velocity), and
 returns the committed stretch followed by the tree's best path. It also reports how far the car
 may drive on the trajectory before a predicted conflict, for the speed governor.
@@ -17,13 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner import _kernel as K
 from planner._paths import pose_at
 from planner._world import clearance, path_clearances
 from planner.options import PlanOptions
 from planner.problem import Problem
 from planner.rrt import Planner
-from planner.sim._reroot import reroot
 from planner.sim.control import Reference
 from planner.sim.predict import inflated, predicted_world
 from planner.sim.sensing import Sensing
@@ -121,21 +119,9 @@ class Replanner:
             return tuple(pose), 0, 0.0, 0.0
         s_c = min(s_now + commit, ref.length)
         if self.attached and self.planner is not None:
-            chain = self.planner.best_path_nodes()
-            tree = self.planner._tree
             s_c = max(s_c, self.root_s)  # never behind the tree's root (the last commit)
-            rel = s_c - self.root_s
-            costs = tree.cost[chain]
-            i = int(np.searchsorted(costs, rel, side="right"))
-            if i >= len(chain):
-                return tuple(tree.pose[chain[-1]]), chain[-1], 0.0, s_c
-            node, par = chain[i], chain[i - 1]
-            skip = rel - costs[i - 1]
-            if skip <= 1e-12:
-                return tuple(tree.pose[par]), par, 0.0, s_c
-            x, y, th, _, _ = pose_at(*tree.pose[par], tree.kinds[node], tree.lens[node],
-                                     self.problem.rho, skip)
-            return (x, y, th), node, skip, s_c
+            pose, anchor, skip = self.planner.best_path_at(s_c - self.root_s)
+            return pose, anchor, skip, s_c
         return tuple(ref.point_at(s_c)[:3]), -1, 0.0, s_c
 
     def _remaining_cost(self, s_c: float) -> float:
@@ -146,7 +132,7 @@ class Replanner:
     def _new_planner(self, world, root, old: Planner | None, anchor: int, skip: float):
         """A tree rooted at ``root`` holding what is still valid of the old one."""
         same_root = (old is not None and not self.attached
-                     and np.allclose(old._tree.pose[0], root, rtol=0.0, atol=1e-12))
+                     and np.allclose(old.root, root, rtol=0.0, atol=1e-12))
         keep = old is not None and ((self.attached and anchor >= 0) or same_root)
         capacity = max(4096, 2 * old.nodes) if keep else 4096
         problem = dataclasses.replace(
@@ -158,9 +144,7 @@ class Replanner:
         if keep:
             remaining = self._remaining_cost(self._s_c)
             bound = PRUNE_FACTOR * remaining + PRUNE_SLACK if math.isfinite(remaining) else math.inf
-            reroot(old._tree, planner._tree, world, planner._P, 0 if same_root else anchor,
-                   0.0 if same_root else skip, bound)
-            K._update_best(planner._tree)
+            planner.adopt(old, 0 if same_root else anchor, 0.0 if same_root else skip, bound)
         return planner
 
     def _grow(self, planner: Planner, started: float) -> None:
@@ -226,7 +210,6 @@ def warm_up() -> None:
     problem = Problem(None, world, (0.5, 0.5, 0.0), (9, 9, 0.0), 0.5, 0.5, 1.0, 1.0, True)
     old = Planner(problem, PlanOptions())
     old.step(40)
-    new = Planner(problem, PlanOptions())
-    reroot(old._tree, new._tree, world, new._P, 0, 0.0, math.inf)
-    pose_at(0.0, 0.0, 0.0, old._tree.kinds[1], old._tree.lens[1], 1.0, 0.1)
+    Planner(problem, PlanOptions()).adopt(old, 0, 0.0)
+    pose_at(0.0, 0.0, 0.0, np.zeros(5, np.int8), np.full(5, 0.2), 1.0, 0.1)
     _warm = True

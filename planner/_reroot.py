@@ -1,4 +1,4 @@
-"""Re-rooting an RRT* tree at a committed state (compiled; the only njit code of the simulator).
+"""Re-rooting an RRT* tree at a committed state (compiled; `Planner.adopt` is its public face).
 
 The committed state lies on an edge of the old tree (or on a node). The new tree's root is that
 state; the part of the old edge still ahead becomes the root's first edge, and the whole subtree
