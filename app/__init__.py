@@ -1,1 +1,1 @@
-"""Trackstar's edges: the CLI (and later the REST API and the browser studio)."""
+"""Trackstar's edges: the `trackstar` CLI, the REST API (FastAPI) and the browser studio (viser)."""

@@ -72,7 +72,7 @@ _WORDS = np.array(
 
 
 @njit(cache=True, inline="always")
-def _mod2pi(a: float) -> float:
+def _wrap_pi(a: float) -> float:
     """Wrap to [−π, π] (OMPL's mod2pi: fmod, then one correction).
 
     The common cases |a| < 2π skip the fmod; the result is bit-identical either way.
@@ -93,26 +93,26 @@ def _mod2pi(a: float) -> float:
 
 @njit(cache=True)
 def _tau_omega(u, v, xi, eta, phi):
-    delta = _mod2pi(u - v)
+    delta = _wrap_pi(u - v)
     a = math.sin(u) - math.sin(delta)
     b = math.cos(u) - math.cos(delta) - 1.0
     t1 = math.atan2(eta * a - xi * b, xi * a + eta * b)
     t2 = 2.0 * (math.cos(delta) - math.cos(v) - math.cos(u)) + 3.0
-    tau = _mod2pi(t1 + PI) if t2 < 0.0 else _mod2pi(t1)
-    omega = _mod2pi(tau - u + v - phi)
+    tau = _wrap_pi(t1 + PI) if t2 < 0.0 else _wrap_pi(t1)
+    omega = _wrap_pi(tau - u + v - phi)
     return tau, omega
 
 
 @njit(cache=True)
 def _turn_opp(a):
     """Lower bound on |p| + |q| when p − q ≡ a (mod 2π), less a rounding slack."""
-    return abs(_mod2pi(a)) - _SLACK
+    return abs(_wrap_pi(a)) - _SLACK
 
 
 @njit(cache=True)
 def _turn_same(a):
     """Lower bound on p + q for p, q ≥ 0 (up to the acceptance slack) with p + q ≡ a (mod 2π)."""
-    m = _mod2pi(a)
+    m = _wrap_pi(a)
     if m < 0.0:
         m += TWO_PI
     if m > TWO_PI - 1e-9:  # a ≡ −0: both may be (almost) zero
@@ -137,7 +137,7 @@ def _lp_sp_lp(x, y, phi, sp, cp, lmin):
         return False, 0.0, 0.0, 0.0
     t = math.atan2(eta, xi)
     if t >= -_ZERO:
-        v = _mod2pi(phi - t)
+        v = _wrap_pi(phi - t)
         if v >= -_ZERO:
             return True, t, u, v
     return False, 0.0, 0.0, 0.0
@@ -155,7 +155,7 @@ def _lp_sp_rp(x, y, phi, sp, cp, lmin):
             return False, 0.0, 0.0, 0.0
         # t = atan2(η, ξ) + atan2(2, u), as one atan2 of the product (ξ + iη)(u + 2i)
         t = math.atan2(eta * u + 2.0 * xi, xi * u - 2.0 * eta)
-        v = _mod2pi(t - phi)
+        v = _wrap_pi(t - phi)
         if t >= -_ZERO and v >= -_ZERO:
             return True, t, u, v
     return False, 0.0, 0.0, 0.0
@@ -170,8 +170,8 @@ def _lp_rm_l(x, y, phi, sp, cp, lmin):
     if r <= 4.0 and 0.5 * r * (1.0 - 1e-9) < lmin:  # |u| = 2 asin(r/4) ≥ r/2
         theta = math.atan2(eta, xi)
         u = -2.0 * math.asin(0.25 * r)
-        t = _mod2pi(theta + 0.5 * u + PI)
-        v = _mod2pi(phi - t + u)
+        t = _wrap_pi(theta + 0.5 * u + PI)
+        v = _wrap_pi(phi - t + u)
         if t >= -_ZERO and u <= _ZERO:
             return True, t, u, v
     return False, 0.0, 0.0, 0.0
@@ -221,7 +221,7 @@ def _lp_rm_sm_lm(x, y, phi, sp, cp, lmin):
             return False, 0.0, 0.0, 0.0
         # t = atan2(η, ξ) + atan2(r, −2), as one atan2 of the product (ξ + iη)(−2 + ir)
         t = math.atan2(xi * r - 2.0 * eta, -2.0 * xi - eta * r)
-        v = _mod2pi(phi - HALF_PI - t)
+        v = _wrap_pi(phi - HALF_PI - t)
         if t >= -_ZERO and u <= _ZERO and v <= _ZERO:
             return True, t, u, v
     return False, 0.0, 0.0, 0.0
@@ -237,7 +237,7 @@ def _lp_rm_sm_rm(x, y, phi, sp, cp, lmin):
     if r >= 2.0 and r - 2.0 + HALF_PI + _turn_same(phi - HALF_PI) < lmin:
         t = math.atan2(xi, -eta)
         u = 2.0 - r
-        v = _mod2pi(t + HALF_PI - phi)
+        v = _wrap_pi(t + HALF_PI - phi)
         if t >= -_ZERO and u <= _ZERO and v <= _ZERO:
             return True, t, u, v
     return False, 0.0, 0.0, 0.0
@@ -252,8 +252,8 @@ def _lp_rm_s_lm_rp(x, y, phi, sp, cp, lmin):
     if rr >= 4.0:
         u = 4.0 - math.sqrt(rr - 4.0)
         if u <= _ZERO and PI - u + _turn_opp(phi) < lmin:  # t − v ≡ φ
-            t = _mod2pi(math.atan2((4.0 - u) * xi - 2.0 * eta, -2.0 * xi + (u - 4.0) * eta))
-            v = _mod2pi(t - phi)
+            t = _wrap_pi(math.atan2((4.0 - u) * xi - 2.0 * eta, -2.0 * xi + (u - 4.0) * eta))
+            v = _wrap_pi(t - phi)
             if t >= -_ZERO and v >= -_ZERO:
                 return True, t, u, v
     return False, 0.0, 0.0, 0.0
@@ -389,7 +389,7 @@ def _normalise(x0, y0, th0, x1, y1, th1, rho):
     s = math.sin(th0)
     dx = x1 - x0
     dy = y1 - y0
-    return (c * dx + s * dy) / rho, (-s * dx + c * dy) / rho, _mod2pi(th1 - th0)
+    return (c * dx + s * dy) / rho, (-s * dx + c * dy) / rho, _wrap_pi(th1 - th0)
 
 
 @njit(cache=True)

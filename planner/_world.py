@@ -1,9 +1,10 @@
 """The world as flat arrays for compiled kernels: bounds, obstacles, motions, drivable region.
 
-Collision semantics are FORMAT.md's: a pose at time t is valid iff the car's disc (radius r) is
-inside the bounds, strictly clear of every obstacle where that obstacle is at time t, and (for a
-track) inside the drivable region. `clearance` returns the signed distance from the disc to the
-nearest forbidden point, so "valid" is ``clearance > 0``.
+Collision semantics are FORMAT.md's: a pose at time t is valid iff the car's footprint discs
+(one disc of radius r, or the discs covering a rectangle) are inside the bounds, strictly clear
+of every obstacle where that obstacle is at time t, and (for a track) inside the drivable region.
+`clearance` returns the signed distance from the discs to the nearest forbidden point, so "valid"
+is ``clearance > 0``.
 
 Motion checks are exact, not sampled ("sphere tracing"): at a pose with clearance d nothing can
 be hit before the car has driven d / (1 + v_obs/v) further, since the car's position moves at

@@ -194,8 +194,9 @@ class Planner:
             if not K.iterate(self._tree, self.problem.world, self._P,
                              target - self.iterations, events):
                 self._tree = K.grown(self._tree, 2 * self._tree.pose.shape[0])
-        self._compute_time += time.perf_counter() - t0
-        self._note_progress(done_before)
+        took = time.perf_counter() - t0
+        self._compute_time += took
+        self._note_progress(done_before, took)
         if self._listeners:
             n_rows, n_near, n_rw = events.cnt
             batch = TreeEvents(events.rows[:n_rows].copy(), events.near[:n_near].copy(),
@@ -209,14 +210,17 @@ class Planner:
                         np.zeros((max(64, 16 * iterations), 4), np.int64),
                         np.zeros(3, np.int64))
 
-    def _note_progress(self, iterations_before: int) -> None:
+    def _note_progress(self, iterations_before: int, batch_s: float) -> None:
         cost = self.best_cost
         if cost is None or cost >= self._best_cost:
             return
         now = self._compute_time
         if self._clock.first_solution_s is None:
-            # Interpolate inside the batch: the kernel knows the iteration of the first solution.
-            self._clock.first_solution_s = now
+            # Inside the batch, in proportion to its iterations: the kernel records the
+            # iteration of the first solution (FIRST_ITER).
+            done = max(self.iterations - iterations_before, 1)
+            share = (self._tree.cnt[K.FIRST_ITER] - iterations_before) / done
+            self._clock.first_solution_s = now - batch_s * (1.0 - min(max(share, 0.0), 1.0))
         self._best_cost = cost
         self._clock.cost_over_time.append((now, cost))
 

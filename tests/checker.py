@@ -42,6 +42,17 @@ def _edge_distance(pts: np.ndarray, x: float, y: float) -> float:
     return float(np.hypot(a[:, 0] + u * ab[:, 0] - x, a[:, 1] + u * ab[:, 1] - y).min())
 
 
+def _outline(ob: dict) -> np.ndarray:
+    """A polygon's points, or a box's corners (rich schema: centre, size, angle_deg)."""
+    if ob["type"] == "polygon":
+        return np.asarray(ob["points"], dtype=float)
+    (cx, cy), (length, width) = ob["center"], ob["size"]
+    a = math.radians(ob.get("angle_deg", 0.0))
+    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * [length / 2, width / 2]
+    rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+    return corners @ rot.T + [cx, cy]
+
+
 def pose_valid(scn: dict, x: float, y: float, t: float | None) -> bool:
     """FORMAT.md validity at time t (None: static obstacles only)."""
     r = scn["vehicle"].get("radius", 0.0)
@@ -57,7 +68,7 @@ def pose_valid(scn: dict, x: float, y: float, t: float | None) -> bool:
             if math.hypot(x - cx - dx, y - cy - dy) <= ob["radius"] + r:
                 return False
         else:
-            pts = np.asarray(ob["points"], dtype=float) + [dx, dy]
+            pts = _outline(ob) + [dx, dy]
             if _inside_even_odd(pts, x, y) or (r > 0 and _edge_distance(pts, x, y) <= r):
                 return False
     return True

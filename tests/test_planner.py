@@ -157,3 +157,15 @@ def test_nearest_is_the_true_nearest_by_steering_length(name, steering):
         lengths = [length(*tree.pose[j], *q, problem.rho, math.inf) for j in range(n)]
         assert found == pytest.approx(min(lengths), abs=1e-9)
         assert lengths[node] == pytest.approx(found, abs=1e-9)
+
+
+def test_first_solution_time_falls_inside_its_batch():
+    """One batch of 4000 iterations: the first solution's time is interpolated from the
+    iteration the kernel records, not the batch's end."""
+    problem = planner.compile_problem(planner.parse_scenario(scenario_dict("open_field")))
+    run = planner.Planner(problem, planner.PlanOptions(seed=2))
+    run.step(4000)
+    result = run.result()
+    assert result.solved
+    assert 0.0 < result.time_to_first_solution_s < 0.5 * result.planning_time_s
+    assert result.cost_over_time[0][0] == result.planning_time_s  # improvements: batch ends

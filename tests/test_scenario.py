@@ -81,3 +81,16 @@ def test_rich_schema_boxes_and_waypoints_compile():
 def test_schema_is_json_schema_with_all_obstacle_types():
     schema = planner.scenario_schema()
     assert {"Circle", "Polygon", "Box", "Motion", "Vehicle"} <= set(schema["$defs"])
+
+
+def test_the_independent_checker_knows_boxes():
+    from checker import pose_valid
+
+    scn = {"bounds": [0, 0, 10, 10], "vehicle": {"radius": 0.1},
+           "obstacles": [{"type": "box", "center": [5, 5], "size": [4, 1], "angle_deg": 90}]}
+    assert not pose_valid(scn, 5.0, 6.9, None)  # inside: the box stands upright
+    assert pose_valid(scn, 6.9, 5.0, None)  # beside it, not along it
+    problem = planner.compile_problem(planner.parse_scenario(
+        {**scn, "name": "box", "start": [1, 1, 0], "goal": [9, 9, 0]}))
+    for x, y in [(5.0, 6.9), (6.9, 5.0), (5.55, 5.0), (5.65, 5.0)]:
+        assert pose_valid(scn, x, y, None) == (problem.clearance(x, y) > 0), (x, y)
