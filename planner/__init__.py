@@ -28,9 +28,10 @@ if TYPE_CHECKING:
         scenario_names,
         scenario_schema,
     )
+    from planner.steering import STEERINGS
 
 _HOMES = {
-    "PlanOptions": "options",
+    "PlanOptions": "options", "STEERINGS": "steering",
     "Problem": "problem", "compile_problem": "problem",
     "Planner": "rrt", "Result": "rrt", "TreeEvents": "rrt", "TreeSnapshot": "rrt",
     "Scenario": "scenario", "ScenarioError": "scenario", "bundled_scenario_path": "scenario",
@@ -39,7 +40,7 @@ _HOMES = {
 }
 
 __all__ = [
-    "PlanOptions", "Planner", "Problem", "Result", "Scenario", "ScenarioError", "TreeEvents",
+    "PlanOptions", "Planner", "STEERINGS", "Problem", "Result", "Scenario", "ScenarioError", "TreeEvents",
     "TreeSnapshot", "bundled_scenario_path", "compile_problem", "load_scenario",
     "parse_scenario", "scenario_names", "scenario_schema", "solve",
 ]
@@ -56,7 +57,7 @@ def __getattr__(name: str):
 def solve(scenario: Scenario | Problem, *, time_limit: float | None = 1.0,
           iterations: int | None = None, **options) -> Result:
     """Plan a scenario (or compiled problem) once: ``options`` are `PlanOptions` fields
-    (``planner="rrt"``, ``steering="reeds-shepp"``, ``seed=3``, …)."""
+    (``planner="rrt"``, ``seed=3``, …)."""
     from planner.options import PlanOptions
     from planner.problem import Problem, compile_problem
     from planner.rrt import Planner

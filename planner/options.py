@@ -12,10 +12,11 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-__all__ = ["PLANNERS", "STEERINGS", "PlanOptions", "PositiveFinite", "Seed"]
+from planner.steering import STEERINGS, SteeringName
+
+__all__ = ["PLANNERS", "PlanOptions", "PositiveFinite", "Seed"]
 
 PLANNERS = ("rrt", "rrtstar")
-STEERINGS = ("dubins", "reeds-shepp")
 DEFAULT_TIME_S = 1.0
 
 PositiveFinite = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -30,9 +31,9 @@ class PlanOptions(BaseModel):
     planner: Literal["rrt", "rrtstar"] = Field(
         "rrtstar", description="Planning algorithm: RRT stops at its first solution, RRT* "
                                "goes on improving it.")
-    steering: Literal["dubins", "reeds-shepp"] = Field(
-        "dubins", description="Car steering: Dubins drives forward only, Reeds-Shepp reverses "
-                              "too.")
+    steering: SteeringName = Field(
+        next(iter(STEERINGS)), description="Car steering: " + "; ".join(
+            f"{s.name} {s.summary}" for s in STEERINGS.values()) + ".")
     time: PositiveFinite | None = Field(
         None, description="Time budget in seconds [default: 1.0, or none when an iteration "
                           "budget is given].")

@@ -19,8 +19,9 @@ from planner._paths import pose_at, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
 from planner._world import path_clearances
-from planner.options import PLANNERS, STEERINGS, PlanOptions
+from planner.options import PLANNERS, PlanOptions
 from planner.problem import Problem
+from planner.steering import STEERINGS
 
 __all__ = ["Planner", "Result", "TreeEvents", "TreeSnapshot", "warm_up"]
 
@@ -108,7 +109,7 @@ class Planner:
         P[K.GPOS], P[K.GHEAD] = problem.goal_position_tol, problem.goal_heading_tol
         P[K.INFORMED] = float(s.informed)
         P[K.STAR] = float(s.planner == "rrtstar")
-        P[K.REVERSE] = float(s.steering == "reeds-shepp")
+        P[K.REVERSE] = float(STEERINGS[s.steering].reverses)
         P[K.SX], P[K.SY] = problem.start[:2]
         P[K.K_RRT] = s.k_rrt or 0.0
         self._P = P

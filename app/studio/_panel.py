@@ -4,13 +4,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import planner
 import tracks
 from app.studio._extend import render
 
 __all__ = ["MOTIONS", "PLANNERS", "SPEEDS", "STEERINGS", "Panel", "build_panel"]
 
 PLANNERS = {"RRT*": "rrtstar", "RRT": "rrt"}
-STEERINGS = {"Dubins": "dubins", "Reeds-Shepp": "reeds-shepp"}
+STEERINGS = {s.label: s.name for s in planner.STEERINGS.values()}
 MOTIONS = ("static", "velocity", "waypoints", "follow track")
 SPEEDS = {"max": None, "2000 it/s": 2000.0, "200 it/s": 200.0, "20 it/s": 20.0}
 
