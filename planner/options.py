@@ -28,7 +28,7 @@ class PlanOptions(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
-    planner: Literal["rrt", "rrtstar"] = Field(
+    planner: Literal[PLANNERS] = Field(
         "rrtstar", description="Planning algorithm: RRT stops at its first solution, RRT* "
                                "goes on improving it.")
     steering: SteeringName = Field(

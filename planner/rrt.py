@@ -273,7 +273,7 @@ class Planner:
     @property
     def root(self) -> tuple[float, float, float]:
         """The root's pose (x, y, θ)."""
-        return tuple(float(v) for v in self._tree.pose[0])
+        return self._pose(0)
 
     def best_path_at(self, s: float) -> tuple[tuple[float, float, float], int, float]:
         """Where the best path is ``s`` metres (driven) from the root: (pose, anchor, skip),
