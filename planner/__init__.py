@@ -13,6 +13,7 @@ options) does not load numba and the compiled kernels.
 from __future__ import annotations
 
 import importlib
+import os
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -54,13 +55,17 @@ def __getattr__(name: str):
     return value
 
 
-def solve(scenario: Scenario | Problem, *, time_limit: float | None = 1.0,
+def solve(scenario: Scenario | Problem | str | os.PathLike, *, time_limit: float | None = 1.0,
           iterations: int | None = None, **options) -> Result:
-    """Plan a scenario (or compiled problem) once: ``options`` are `PlanOptions` fields
-    (``planner="rrt"``, ``seed=3``, …)."""
+    """Plan a scenario once — a `Scenario`, a compiled `Problem`, a scenario file or a bundled
+    scenario's name (``planner.solve("slalom", seed=3)``); ``options`` are `PlanOptions`
+    fields (``planner="rrt"``, ``steering="reeds-shepp"``, …)."""
     from planner.options import PlanOptions
     from planner.problem import Problem, compile_problem
     from planner.rrt import Planner
+    from planner.scenario import load_scenario
 
+    if isinstance(scenario, (str, os.PathLike)):
+        scenario = load_scenario(scenario)
     problem = scenario if isinstance(scenario, Problem) else compile_problem(scenario)
     return Planner(problem, PlanOptions(**options)).solve(time_limit, iterations)

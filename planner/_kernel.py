@@ -25,17 +25,22 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from planner._dubins import (dubins_length_cs, dubins_lower_bound, dubins_word_bound,
-                             turning_centres)
+from planner._dubins import turning_centres
 from planner._paths import path_end, truncate, wrap_angle
 from planner._rng import uniform
-from planner._reeds_shepp import reeds_shepp_length
-from planner._steer import steer_path
+from planner._steer import (
+    arrival_heading,
+    state,
+    steer_bound,
+    steer_length,
+    steer_path,
+    steer_tight_bound,
+)
 from planner._world import World, motion_free, static_clearance_estimate
 
 # Parameter vector indices.
-(EPS, GAMMA, GOAL_BIAS, RHO, SPEED, GX, GY, GTH, GPOS, GHEAD, INFORMED, STAR, REVERSE,
- SX, SY, K_RRT, NPARAMS) = range(17)
+(EPS, GAMMA, GOAL_BIAS, RHO, SPEED, GX, GY, GTH, GPOS, GHEAD, INFORMED, STAR, STEERING,
+ SX, SY, K_RRT, DIMS, NPARAMS) = range(18)
 LANE_SHARE, LANE_SIGMA = 0.9, 0.25  # track scenarios: headings sampled along the lane
 NEAREST_BUCKETS = 256  # nearest's queue: half-cell buckets, the last one takes the rest
 # Counter indices.
@@ -191,67 +196,10 @@ def _lane_heading(tree: Tree, w: World, x, y, th) -> float:
 
 
 @njit(cache=True, inline="always")
-def _cheap_bound(x0, y0, th0, x1, y1, th1, rho) -> float:
-    """A lower bound of every car path length between two poses: the path is at least the
-    straight line, and it turns the heading by at least |Δθ| at curvature ≤ 1/ρ."""
-    return max(math.hypot(x1 - x0, y1 - y0), rho * abs(wrap_angle(th1 - th0)))
-
-
-@njit(cache=True, inline="always")
-def _bound_to(tree: Tree, P, j, x, y, th, c, s) -> float:
-    """A cheap lower bound of the steering length from node j to the pose (x, y, th) with
-    cos and sin c, s: the turning circles' bound for Dubins, `_cheap_bound` with reversing."""
-    if P[REVERSE] > 0.0:
-        return _cheap_bound(tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], x, y, th, P[RHO])
-    lx, ly, rx, ry = turning_centres(x, y, c, s, P[RHO])
-    f = tree.trig
-    return dubins_lower_bound(f[j, 2], f[j, 3], f[j, 4], f[j, 5], lx, ly, rx, ry,
-                              wrap_angle(th - tree.pose[j, 2]), P[RHO])
-
-
-@njit(cache=True, inline="always")
-def _word_bound_to(tree: Tree, P, j, x, y, th, c, s) -> float:
-    """A tighter, dearer bound than `_bound_to` for Dubins (`dubins_word_bound`); with
-    reversing there is none, and 0 leaves `_bound_to`'s standing."""
-    if P[REVERSE] > 0.0:
-        return 0.0
-    lx, ly, rx, ry = turning_centres(x, y, c, s, P[RHO])
-    f = tree.trig
-    return dubins_word_bound(f[j, 2], f[j, 3], f[j, 4], f[j, 5], f[j, 0], f[j, 1], lx, ly, rx,
-                             ry, c, s, wrap_angle(th - tree.pose[j, 2]), P[RHO])
-
-
-@njit(cache=True, inline="always")
-def _bound_from(tree: Tree, P, x, y, th, c, s, j) -> float:
-    """`_bound_to` the other way: from the pose to node j."""
-    if P[REVERSE] > 0.0:
-        return _cheap_bound(x, y, th, tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], P[RHO])
-    lx, ly, rx, ry = turning_centres(x, y, c, s, P[RHO])
-    f = tree.trig
-    return dubins_lower_bound(lx, ly, rx, ry, f[j, 2], f[j, 3], f[j, 4], f[j, 5],
-                              wrap_angle(tree.pose[j, 2] - th), P[RHO])
-
-
-@njit(cache=True, inline="always")
-def _length_to(tree: Tree, P, j, x, y, th, c, s, bound) -> float:
-    """Steering length from node j to the pose (x, y, th) whose cos and sin are c, s; any
-    value ≥ ``bound`` once it cannot beat it (callers first try the cheaper `_bound_to`)."""
-    if P[REVERSE] > 0.0:
-        return reeds_shepp_length(tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2], x, y, th,
-                                  P[RHO], bound)
-    return dubins_length_cs(tree.pose[j, 0], tree.pose[j, 1], tree.trig[j, 0], tree.trig[j, 1],
-                            x, y, c, s, P[RHO], bound)
-
-
-@njit(cache=True, inline="always")
-def _length_from(tree: Tree, P, x, y, th, c, s, j, bound) -> float:
-    """Steering length from the pose (x, y, th) (cos and sin c, s) to node j; see
-    `_length_to`."""
-    if P[REVERSE] > 0.0:
-        return reeds_shepp_length(x, y, th, tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2],
-                                  P[RHO], bound)
-    return dubins_length_cs(x, y, c, s, tree.pose[j, 0], tree.pose[j, 1], tree.trig[j, 0],
-                            tree.trig[j, 1], P[RHO], bound)
+def _node(tree: Tree, j):
+    """Node j as a steering `state` (its cos, sin and turning circles are kept in tree.trig)."""
+    p, f = tree.pose, tree.trig
+    return p[j, 0], p[j, 1], p[j, 2], f[j, 0], f[j, 1], f[j, 2], f[j, 3], f[j, 4], f[j, 5]
 
 
 @njit(cache=True, inline="always")
@@ -300,10 +248,11 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
     least (k − 1) cells away), so the first ones are usually near-optimal and the search
     stops when neither a bucket nor the next ring can beat the best length found. Filing
     costs a store where a heap cost a sift. A node taken from its bucket first gets the
-    tighter `_word_bound_to` and is filed again (key −1 − bound) if that moves it up: poses
+    tighter `steer_tight_bound` and is filed again (key −1 − bound) if that moves it up: poses
     facing back at the tree pass the turning circles' bound by the hundred on a small track.
     """
-    qc, qs = math.cos(qth), math.sin(qth)
+    code, rho = int(P[STEERING]), P[RHO]
+    to = state(qx, qy, qth, math.cos(qth), math.sin(qth), rho)
     nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
     ci, cj = _cell(tree, qx, qy)
     cells = np.empty(8 * (max(nx, ny) + 1), np.int64)
@@ -325,7 +274,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             if lb >= 0.0:  # filed by its cheap bound: refine it first
                 if lb >= best:
                     continue
-                lb = max(lb, _word_bound_to(tree, P, node, qx, qy, qth, qc, qs))
+                lb = max(lb, steer_tight_bound(code, _node(tree, node), to, rho))
                 b = min(int(lb / width), NEAREST_BUCKETS - 1)
                 if lb < best and b > cur:  # no longer among the lowest: file it again
                     key[node] = -1.0 - lb
@@ -336,7 +285,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             else:
                 lb = -1.0 - lb  # refined before
             if lb < best:
-                d = _length_to(tree, P, node, qx, qy, qth, qc, qs, best)
+                d = steer_length(code, _node(tree, node), to, rho, best)
                 if d < best:
                     best, besti = d, node
         elif ring_bound >= best:
@@ -345,7 +294,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             for q in range(_ring_cells(tree, ci, cj, k, cells)):
                 node = tree.cell_head[cells[q]]
                 while node >= 0:
-                    lb = _bound_to(tree, P, node, qx, qy, qth, qc, qs)
+                    lb = steer_bound(code, _node(tree, node), to, rho)
                     if lb < best:
                         b = min(int(lb / width), NEAREST_BUCKETS - 1)
                         key[node] = lb
@@ -513,7 +462,8 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
     leaves the winning edge in kinds/lens.
     """
     keys, vals = tree.near_key, tree.stack
-    c, s = math.cos(th), math.sin(th)
+    code, rho = int(P[STEERING]), P[RHO]
+    to = state(x, y, th, math.cos(th), math.sin(th), rho)
     size = 0
     for q in range(m):
         j = tree.near[q]
@@ -521,7 +471,7 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
             continue
         if tree.near_len[q] >= radius or tree.cost[j] + tree.near_len[q] >= c_new - 1e-12:
             continue
-        lb = _bound_to(tree, P, j, x, y, th, c, s)
+        lb = steer_bound(code, _node(tree, j), to, rho)
         if lb < radius and tree.cost[j] + lb < c_new - 1e-12:
             size = _heap_push(keys, vals, size, tree.cost[j] + lb, j)
     while size > 0 and keys[0] < c_new - 1e-12:
@@ -531,11 +481,11 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
         px, py, pth = tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2]
         if v >= 0:
             bound = min(radius, c_new - tree.cost[j])
-            d = _length_to(tree, P, j, x, y, th, c, s, bound)
+            d = steer_length(code, _node(tree, j), to, rho, bound)
             if d < bound:
                 size = _heap_push(keys, vals, size, tree.cost[j] + d, -1 - j)
             continue
-        steer_path(P[REVERSE], px, py, pth, x, y, th, P[RHO], pk, pl)
+        steer_path(code, px, py, pth, x, y, th, rho, pk, pl)
         tree.cnt[CHECKS] += 1
         if motion_free(w, px, py, pth, tree.cost[j] / P[SPEED], pk, pl, P[RHO], P[SPEED],
                        counter):
@@ -559,6 +509,7 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
     scratch_l = np.zeros(5)
     counter = np.zeros(1, np.int64)
     timed = w.m_kind.shape[0] > 0
+    code = int(P[STEERING])
     for _ in range(n_iter):
         if tree.cnt[N] >= tree.pose.shape[0]:
             return False
@@ -582,7 +533,8 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
             continue
         near_i, dist = nearest(tree, P, xr, yr, thr)
         nx0, ny0, nth0 = tree.pose[near_i, 0], tree.pose[near_i, 1], tree.pose[near_i, 2]
-        steer_path(P[REVERSE], nx0, ny0, nth0, xr, yr, thr, P[RHO], kinds, lens)
+        thr = arrival_heading(code, nx0, ny0, nth0, xr, yr, thr)
+        steer_path(code, nx0, ny0, nth0, xr, yr, thr, P[RHO], kinds, lens)
         if dist > P[EPS]:
             truncate(kinds, lens, P[EPS], cut)
             lens[:] = cut
@@ -612,7 +564,7 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
                 radius = math.inf
                 m = _near(tree, x, y, radius, int(math.ceil(P[K_RRT] * math.log(n))))
             else:
-                radius = min(P[GAMMA] * (math.log(n) / n) ** (1.0 / 3.0), P[EPS])
+                radius = min(P[GAMMA] * (math.log(n) / n) ** (1.0 / P[DIMS]), P[EPS])
                 m = _near(tree, x, y, radius, 0)
             c_new, parent = _choose_parent(tree, w, P, m, x, y, th, radius, c_new, parent,
                                            kinds, lens, scratch_k, scratch_l, counter)
@@ -631,19 +583,19 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
                     ev.cnt[1] += 1
             ev.rows[row, EV_NEAR_END] = ev.cnt[1]
         # Rewire: near nodes that are cheaper to reach through the new node.
-        c, s = tree.trig[new, 0], tree.trig[new, 1]
+        frm = _node(tree, new)
         for q in range(m):
             j = tree.near[q]
             if j == parent:
                 continue
             budget = min(tree.cost[j] - c_new, radius)
-            if tree.near_len[q] >= budget - 1e-9 or _bound_from(
-                    tree, P, x, y, th, c, s, j) >= budget - 1e-9:
+            if tree.near_len[q] >= budget - 1e-9 or steer_bound(
+                    code, frm, _node(tree, j), P[RHO]) >= budget - 1e-9:
                 continue  # not even the lower bound could make j cheaper
-            l = _length_from(tree, P, x, y, th, c, s, j, budget)
+            l = steer_length(code, frm, _node(tree, j), P[RHO], budget)
             if l >= budget - 1e-9:
                 continue
-            steer_path(P[REVERSE], x, y, th, tree.pose[j, 0], tree.pose[j, 1],
+            steer_path(code, x, y, th, tree.pose[j, 0], tree.pose[j, 1],
                        tree.pose[j, 2], P[RHO], kinds, lens)
             tree.cnt[CHECKS] += 1
             if not motion_free(w, x, y, th, c_new / P[SPEED], kinds, lens, P[RHO], P[SPEED],

@@ -1,9 +1,12 @@
-"""Car paths as at most five arc/straight segments — the one representation of a local motion.
+"""Local motions as at most five segments — the one representation every steering writes.
 
-Dubins and Reeds-Shepp words are both written as ``kinds`` (int8[5]: +1 left arc, 0 straight,
--1 right arc) and ``lens`` (float64[5]: signed arc length in metres, negative = reversing; unused
-slots are 0). Arcs have radius ``rho``. Everything downstream — sampling, collision checks,
-curvature profiles — reads only this form, so both steering functions share one integrator.
+``kinds`` (int8[5]: +1 left arc, 0 straight, -1 right arc, 2 turn on the spot) and ``lens``
+(float64[5]: signed arc length in metres, negative = reversing; for a turn on the spot the
+signed angle in radians, which drives no length; unused slots are 0). Arcs have radius ``rho``.
+Everything downstream — sampling, collision checks, curvature profiles — reads only this form,
+so all steering functions share one integrator. A turn on the spot is taken when the motion goes
+on past it: the pose at driven length 0 is the start pose, the pose at the end of the last
+driven segment has not yet taken a turn that follows it.
 
 The pose update along a segment is exact (no numerical integration): for a left arc of signed
 length l, θ' = θ + l/ρ, x' = x + ρ(sin θ' − sin θ), y' = y − ρ(cos θ' − cos θ).
@@ -17,27 +20,36 @@ import numpy as np
 from numba import njit
 
 MAX_SEGMENTS = 5
-LEFT, STRAIGHT, RIGHT = 1, 0, -1
+LEFT, STRAIGHT, RIGHT, TURN = 1, 0, -1, 2
 _TWO_PI = 2.0 * math.pi
 
 
 @njit(cache=True, inline="always")
 def advance(x: float, y: float, th: float, kind: int, length: float, rho: float):
-    """Pose after driving ``length`` (signed) on one segment of ``kind`` from (x, y, th)."""
-    if kind == 0:
+    """Pose after driving ``length`` (signed) on one segment of ``kind`` from (x, y, th); for
+    a turn on the spot, ``length`` is its angle."""
+    if kind == STRAIGHT:
         return x + length * math.cos(th), y + length * math.sin(th), th
+    if kind == TURN:
+        return x, y, th + length
     th2 = th + kind * length / rho
     x2 = x + kind * rho * (math.sin(th2) - math.sin(th))
     y2 = y - kind * rho * (math.cos(th2) - math.cos(th))
     return x2, y2, th2
 
 
+@njit(cache=True, inline="always")
+def driven(kind: int, seg: float) -> float:
+    """The length a segment drives: |seg|, and 0 for a turn on the spot."""
+    return 0.0 if kind == TURN else abs(seg)
+
+
 @njit(cache=True)
-def path_length(lens: np.ndarray) -> float:
-    """Driven length of a path: the sum of |segment length|."""
+def path_length(kinds: np.ndarray, lens: np.ndarray) -> float:
+    """Driven length of a path: the sum of the segments' driven lengths."""
     total = 0.0
     for i in range(lens.shape[0]):
-        total += abs(lens[i])
+        total += driven(kinds[i], lens[i])
     return total
 
 
@@ -55,6 +67,10 @@ def pose_at(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray, 
     for i in range(kinds.shape[0]):
         seg = lens[i]
         if seg == 0.0:
+            continue
+        if kinds[i] == TURN:
+            if remaining > 0.0:
+                th += seg
             continue
         kind = kinds[i]
         direction = 1.0 if seg > 0.0 else -1.0
@@ -81,6 +97,9 @@ def truncate(kinds: np.ndarray, lens: np.ndarray, s: float, out_lens: np.ndarray
     remaining = s
     for i in range(kinds.shape[0]):
         seg = lens[i]
+        if kinds[i] == TURN:
+            out_lens[i] = seg if remaining > 0.0 else 0.0
+            continue
         take = min(abs(seg), max(remaining, 0.0))
         out_lens[i] = take if seg >= 0.0 else -take
         remaining -= take
@@ -92,11 +111,13 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
     """Poses every ≤ ``spacing`` metres, both ends and every segment joint included.
 
     Returns an (n, 5) array of x, y, theta, curvature (steering curvature: kind/ρ), direction.
+    A turn on the spot is one row: the same position, the new heading, curvature 0 (the robot
+    does not steer; its heading is free).
     """
     n = 1
     for i in range(kinds.shape[0]):
         if lens[i] != 0.0:
-            n += max(1, int(math.ceil(abs(lens[i]) / spacing - 1e-12)))
+            n += max(1, int(math.ceil(driven(kinds[i], lens[i]) / spacing - 1e-12)))
     out = np.empty((n, 5))
     out[0, 0] = x
     out[0, 1] = y
@@ -106,24 +127,35 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
         if lens[i] != 0.0:
             first = i
             break
-    out[0, 3] = kinds[first] / rho if first >= 0 else 0.0
-    out[0, 4] = 1.0 if first < 0 or lens[first] > 0.0 else -1.0
+    out[0, 3] = _curvature(kinds[first], rho) if first >= 0 else 0.0
+    out[0, 4] = _direction(kinds[first], lens[first]) if first >= 0 else 1.0
     k = 1
     for i in range(kinds.shape[0]):
         seg = lens[i]
         if seg == 0.0:
             continue
-        steps = max(1, int(math.ceil(abs(seg) / spacing - 1e-12)))
+        steps = max(1, int(math.ceil(driven(kinds[i], seg) / spacing - 1e-12)))
         for j in range(1, steps + 1):
             px, py, pth = advance(x, y, th, kinds[i], seg * j / steps, rho)
             out[k, 0] = px
             out[k, 1] = py
             out[k, 2] = pth
-            out[k, 3] = kinds[i] / rho
-            out[k, 4] = 1.0 if seg > 0.0 else -1.0
+            out[k, 3] = _curvature(kinds[i], rho)
+            out[k, 4] = _direction(kinds[i], seg)
             k += 1
         x, y, th = advance(x, y, th, kinds[i], seg, rho)
     return out
+
+
+@njit(cache=True, inline="always")
+def _curvature(kind: int, rho: float) -> float:
+    return 0.0 if kind == TURN else kind / rho
+
+
+@njit(cache=True, inline="always")
+def _direction(kind: int, seg: float) -> float:
+    """+1 forward, -1 reversing; a turn on the spot counts as forward."""
+    return -1.0 if seg < 0.0 and kind != TURN else 1.0
 
 
 @njit(cache=True, inline="always")

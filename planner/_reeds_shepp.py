@@ -440,3 +440,10 @@ def reeds_shepp_length(x0: float, y0: float, th0: float, x1: float, y1: float, t
     if best[1] < 0:
         return math.inf
     return best[0] * rho
+
+
+@njit(cache=True, inline="always")
+def reeds_shepp_lower_bound(x0, y0, th0, x1, y1, th1, rho) -> float:
+    """A lower bound of the Reeds-Shepp length: the path is at least the straight line, and it
+    turns the heading by at least |Δθ| at curvature ≤ 1/ρ."""
+    return max(math.hypot(x1 - x0, y1 - y0), rho * abs(_wrap_pi(th1 - th0)))

@@ -14,6 +14,7 @@ import numpy as np
 from numba import njit
 
 from planner import _kernel as K
+from planner._paths import TURN
 from planner._world import World, motion_free
 
 
@@ -23,6 +24,9 @@ def _tail(kinds, lens, skip, out):
     remaining = skip
     for i in range(lens.shape[0]):
         seg = lens[i]
+        if kinds[i] == TURN:  # taken once the car has gone on past it (see `_paths`)
+            out[i] = 0.0 if remaining > 0.0 else seg
+            continue
         take = min(abs(seg), max(remaining, 0.0))
         left = abs(seg) - take
         out[i] = left if seg >= 0.0 else -left

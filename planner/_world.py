@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from planner._paths import advance
+from planner._paths import TURN, advance
 
 CONTACT = 1e-4
 # Indices into World.geo.
@@ -332,6 +332,9 @@ def motion_free(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> boo
     for i in range(kinds.shape[0]):
         seg = lens[i]
         if seg == 0.0:
+            continue
+        if kinds[i] == TURN:  # on the spot: a disc robot's cover does not change
+            th += seg
             continue
         length = abs(seg)
         direction = 1.0 if seg > 0.0 else -1.0

@@ -12,6 +12,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from planner.scenario import ScenarioError
 from planner.steering import STEERINGS, SteeringName
 
 __all__ = ["PLANNERS", "PlanOptions", "PositiveFinite", "Seed"]
@@ -32,7 +33,7 @@ class PlanOptions(BaseModel):
         "rrtstar", description="Planning algorithm: RRT stops at its first solution, RRT* "
                                "goes on improving it.")
     steering: SteeringName = Field(
-        next(iter(STEERINGS)), description="Car steering: " + "; ".join(
+        next(iter(STEERINGS)), description="Steering: " + "; ".join(
             f"{s.name} {s.summary}" for s in STEERINGS.values()) + ".")
     time: PositiveFinite | None = Field(
         None, description="Time budget in seconds [default: 1.0, or none when an iteration "
@@ -54,6 +55,12 @@ class PlanOptions(BaseModel):
     speed: PositiveFinite | None = Field(
         None, description="Planning speed v [m/s] [default: the scenario's vehicle.speed].")
 
+    @property
+    def dimensions(self) -> int:
+        """The dimension of the space the tree explores: (x, y, θ) for a car, (x, y) for a
+        robot whose heading is free."""
+        return 2 if STEERINGS[self.steering].heading_free else 3
+
     def time_budget(self, max_time: float | None = None) -> float | None:
         """The time limit of the run: 1 s by default, none with only iterations; a server's
         cap ``max_time`` refuses a longer explicit time and bounds the others."""
@@ -66,20 +73,28 @@ class PlanOptions(BaseModel):
 
     def resolved(self, problem) -> PlanOptions:
         """Fill the derived defaults from a `planner.Problem`: ε from the workspace size, γ
-        from the free space, informed sampling and the speed."""
+        from the free space, informed sampling and the speed. Raises `ScenarioError` for a
+        robot the steering cannot drive."""
+        if STEERINGS[self.steering].heading_free and problem.world.discs[:, 0].any():
+            raise ScenarioError(
+                f"steering {self.steering!r} turns on the spot, which only a disc centred on "
+                f"the pose does without sweeping: give vehicle.radius, not vehicle.footprint")
         xmin, ymin, xmax, ymax = problem.bounds
         diag = math.hypot(xmax - xmin, ymax - ymin)
         eps = self.eps if self.eps is not None else max(0.15 * diag, 2.0 * problem.rho)
         if self.gamma is not None:
             gamma = self.gamma
         else:
-            # γ* = (2 (1 + 1/d) μ(X_free) / ζ_d)^(1/d) with d = 3, μ = free area · 2π,
-            # ζ_3 = 4π/3 (Karaman & Frazzoli; OMPL takes the bounds' area, not knowing the free
-            # one, and 1.1 γ*). We take 2.4 γ*: at our iteration rates log(n)/n shrinks the
-            # radius to a fraction of a turning circle within milliseconds, and short rewiring
-            # radii cannot straighten a loop (benchmarks/results/planner.md: cost after 1 s).
-            measure = max(problem.free_area, 1e-9) * 2.0 * math.pi
-            gamma = 2.4 * (2.0 * (4.0 / 3.0) * measure / (4.0 * math.pi / 3.0)) ** (1.0 / 3.0)
+            # γ* = (2 (1 + 1/d) μ(X_free) / ζ_d)^(1/d) (Karaman & Frazzoli; OMPL takes the
+            # bounds' area, not knowing the free one, and 1.1 γ*): for a car d = 3, μ = free
+            # area · 2π, ζ_3 = 4π/3; for a heading-free robot d = 2, μ = free area, ζ_2 = π.
+            # We take 2.4 γ*: at our iteration rates log(n)/n shrinks the radius to a fraction
+            # of a turning circle within milliseconds, and short rewiring radii cannot
+            # straighten a loop (benchmarks/results/planner.md: cost after 1 s).
+            d = self.dimensions
+            measure = max(problem.free_area, 1e-9) * (2.0 * math.pi if d == 3 else 1.0)
+            unit_ball = 4.0 * math.pi / 3.0 if d == 3 else math.pi
+            gamma = 2.4 * (2.0 * (1.0 + 1.0 / d) * measure / unit_ball) ** (1.0 / d)
         informed = self.informed if self.informed is not None else self.planner == "rrtstar"
         speed = self.speed if self.speed is not None else problem.speed
         return self.model_copy(update={"eps": eps, "gamma": gamma, "informed": informed,

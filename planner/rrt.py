@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from planner import _kernel as K
-from planner._paths import pose_at, sample_path
+from planner._paths import path_length, pose_at, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
 from planner._world import path_clearances
@@ -102,16 +102,19 @@ class Planner:
         self._tree = K.new_tree(capacity, grid, seed_state(s.seed))
         self._tree.cnt[K.BEST] = -1
         self._tree.cnt[K.FIRST_ITER] = -1
+        steering = STEERINGS[s.steering]
         P = np.zeros(K.NPARAMS)
         P[K.EPS], P[K.GAMMA], P[K.GOAL_BIAS] = s.eps, s.gamma, s.goal_bias
         P[K.RHO], P[K.SPEED] = problem.rho, s.speed
         P[K.GX], P[K.GY], P[K.GTH] = problem.goal
-        P[K.GPOS], P[K.GHEAD] = problem.goal_position_tol, problem.goal_heading_tol
+        P[K.GPOS] = problem.goal_position_tol
+        P[K.GHEAD] = math.pi if steering.heading_free else problem.goal_heading_tol
         P[K.INFORMED] = float(s.informed)
         P[K.STAR] = float(s.planner == "rrtstar")
-        P[K.REVERSE] = float(STEERINGS[s.steering].reverses)
+        P[K.STEERING] = steering.code
         P[K.SX], P[K.SY] = problem.start[:2]
         P[K.K_RRT] = s.k_rrt or 0.0
+        P[K.DIMS] = s.dimensions
         self._P = P
         zero = np.zeros(5)
         K.add_node(self._tree, P, *problem.start, 0.0, -1, zero.astype(np.int8), zero)
@@ -167,7 +170,7 @@ class Planner:
         parent = int(t.parent[node])
         if parent < 0:
             return np.repeat(t.pose[node:node + 1, :2], count + 1, axis=0)
-        total = float(np.abs(t.lens[node]).sum())
+        total = path_length(t.kinds[node], t.lens[node])
         dense = sample_path(*t.pose[parent], t.kinds[node], t.lens[node], self.problem.rho,
                             max(total / (4 * count), 1e-6))
         pick = np.linspace(0, len(dense) - 1, count + 1).round().astype(int)

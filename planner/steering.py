@@ -1,8 +1,10 @@
 """The steering functions a planner can use, registered under one name each.
 
 Every edge of the system takes its list from `STEERINGS`: the options model (`PlanOptions`),
-`trackstar plan --steering`, the REST schema, the studio's dropdown and the planner's kernel
-(through `reverses`). The compiled implementations live in `_dubins.py` and `_reeds_shepp.py`.
+`trackstar plan --steering`, the REST schema, the studio's dropdown and docs. The compiled
+implementations live one per module (`_dubins.py`, `_reeds_shepp.py`, `_straight.py`); the
+planner's kernel reaches them through `_steer.py` by each entry's integer ``code``. Adding a
+steering function is: its module, an entry here, a branch per function in `_steer.py`.
 """
 
 from __future__ import annotations
@@ -12,20 +14,33 @@ from typing import Literal
 
 __all__ = ["STEERINGS", "Steering", "SteeringName"]
 
+DUBINS, REEDS_SHEPP, STRAIGHT = range(3)  # the kernel's codes (`_steer.py` dispatches on them)
+
 
 @dataclass(frozen=True)
 class Steering:
-    """One registered steering function: its name, a label for people, whether it reverses."""
+    """One registered steering function.
+
+    ``heading_free``: a point or disc robot that turns on the spot — the goal is reached by
+    position, a rectangular footprint (whose sweep a turn on the spot would ignore) is refused,
+    and RRT*'s near radius shrinks as in the plane (d = 2) instead of in (x, y, θ) (d = 3).
+    """
 
     name: str
     label: str
+    code: int
     reverses: bool
+    heading_free: bool
     summary: str
 
 
 STEERINGS = {s.name: s for s in (
-    Steering("dubins", "Dubins", False, "forward only (Dubins 1957)"),
-    Steering("reeds-shepp", "Reeds-Shepp", True, "forward and reverse (Reeds & Shepp 1990)"),
+    Steering("dubins", "Dubins", DUBINS, False, False, "forward only (Dubins 1957)"),
+    Steering("reeds-shepp", "Reeds-Shepp", REEDS_SHEPP, True, False,
+             "forward and reverse (Reeds & Shepp 1990)"),
+    Steering("straight", "Straight line", STRAIGHT, False, True,
+             "straight lines for a point or disc robot that turns on the spot, goal by "
+             "position (the classic RRT picture, LaValle 1998)"),
 )}
 
 SteeringName = Literal[tuple(STEERINGS)]  # the names, for pydantic and typer

@@ -52,7 +52,7 @@ def test_exact_endpoint_and_length(q0, q1):
     end = path_end(*q0, kinds, lens, RHO)
     assert end[:2] == pytest.approx(q1[:2], abs=1e-9)
     assert math.remainder(end[2] - q1[2], 2 * math.pi) == pytest.approx(0.0, abs=1e-9)
-    assert path_length(lens) == pytest.approx(length, abs=1e-12)
+    assert path_length(kinds, lens) == pytest.approx(length, abs=1e-12)
     assert np.all(lens >= 0)  # forward only
     assert length >= math.hypot(q1[0] - q0[0], q1[1] - q0[1]) * (1 - 1e-9) - 1e-12
 

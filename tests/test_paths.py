@@ -29,5 +29,5 @@ def test_samples_are_continuous_and_end_at_the_end(kinds, lens, rho):
     end = path_end(0.5, -0.2, 0.3, kinds, lens, rho)
     assert np.allclose(pts[-1, :3], end, atol=1e-9)
     assert np.all(np.hypot(*np.diff(pts[:, :2], axis=0).T) <= 0.02 + 1e-9)
-    mid = pose_at(0.5, -0.2, 0.3, kinds, lens, rho, path_length(lens))
+    mid = pose_at(0.5, -0.2, 0.3, kinds, lens, rho, path_length(kinds, lens))
     assert np.allclose(mid[:3], end, atol=1e-9)

@@ -16,7 +16,7 @@ def plan(name, iterations=3000, **kw):
 
 
 @pytest.mark.parametrize("name", STATIC)
-@pytest.mark.parametrize("steering", ["dubins", "reeds-shepp"])
+@pytest.mark.parametrize("steering", list(planner.STEERINGS))
 def test_paths_are_valid_continuous_and_feasible(name, steering):
     result = plan(name, iterations=4000, steering=steering)
     assert result.solved, f"{name} not solved in 4000 iterations"
@@ -26,9 +26,12 @@ def test_paths_are_valid_continuous_and_feasible(name, steering):
     assert path[0, :3] == pytest.approx(scn["start"], abs=1e-12)
     gx, gy, gth = scn["goal"]
     assert math.hypot(path[-1, 0] - gx, path[-1, 1] - gy) <= 0.25 + 1e-9
-    assert abs(math.remainder(path[-1, 2] - gth, 2 * math.pi)) <= math.radians(20) + 1e-9
+    if not planner.STEERINGS[steering].heading_free:  # else the goal is reached by position
+        assert abs(math.remainder(path[-1, 2] - gth, 2 * math.pi)) <= math.radians(20) + 1e-9
     assert np.all(np.hypot(*np.diff(path[:, :2], axis=0).T) <= 0.05 + 1e-9)
     assert np.all(np.abs(path[:, 3]) <= 1 / rho + 1e-9)
+    if steering == "straight":
+        assert np.all(path[:, 3] == 0.0)
     assert arc_mismatch(path[:, :3]) < 1e-6
     assert first_collision(scn, path[:, :3]) is None
     # The reported cost is the driven length of the returned path.
@@ -135,26 +138,27 @@ def test_live_poses_are_a_read_only_view_and_the_root_edge_is_a_dot():
     assert run.edge_points(0, 4) == pytest.approx(np.repeat(poses[:1, :2], 5, axis=0))
 
 
-@pytest.mark.parametrize("steering", ["dubins", "reeds-shepp"])
+@pytest.mark.parametrize("steering", list(planner.STEERINGS))
 @pytest.mark.parametrize("name", ["hallway", "oval_track"])
 def test_nearest_is_the_true_nearest_by_steering_length(name, steering):
     """The pruned best-first search returns what a scan of every node returns (OMPL's way)."""
     from planner import Planner, PlanOptions
     from planner import _kernel as K
-    from planner._dubins import dubins_length
-    from planner._reeds_shepp import reeds_shepp_length
+    from planner._steer import steer_path
 
     problem = planner.compile_problem(planner.parse_scenario(scenario_dict(name)))
     run = Planner(problem, PlanOptions(steering=steering, seed=3))
     run.step(3000)
     tree, n = run._tree, run.nodes
-    length = dubins_length if steering == "dubins" else reeds_shepp_length
+    code = planner.STEERINGS[steering].code
+    kinds, lens = np.zeros(5, np.int8), np.zeros(5)
     rng = np.random.default_rng(0)
     xmin, ymin, xmax, ymax = problem.bounds
     for _ in range(150):
         q = (rng.uniform(xmin, xmax), rng.uniform(ymin, ymax), rng.uniform(-math.pi, math.pi))
         node, found = K.nearest(tree, run._P, *q)
-        lengths = [length(*tree.pose[j], *q, problem.rho, math.inf) for j in range(n)]
+        lengths = [steer_path(code, *tree.pose[j], *q, problem.rho, kinds, lens)
+                   for j in range(n)]
         assert found == pytest.approx(min(lengths), abs=1e-9)
         assert lengths[node] == pytest.approx(found, abs=1e-9)
 

@@ -106,7 +106,7 @@ def build_panel(gui) -> Panel:
         scenario_load = gui.add_button("Load from server")
     with gui.add_folder("Planner"):
         planner = gui.add_dropdown("Planner", tuple(PLANNERS), initial_value="RRT*")
-        steering = gui.add_dropdown("Steering", tuple(STEERINGS), initial_value="Dubins")
+        steering = gui.add_dropdown("Steering", tuple(STEERINGS))
         eps = gui.add_number("ε (m, 0 = auto)", 0.0, min=0.0, step=0.05)
         gamma = gui.add_number("γ (0 = auto)", 0.0, min=0.0, step=0.5)
         k_rrt = gui.add_number("k (0 = radius form)", 0.0, min=0.0, step=0.5)

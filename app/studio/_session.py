@@ -205,6 +205,7 @@ class Session:
                 self.view.clear()
             try:
                 options = self.options()
+                options.resolved(self.problem)  # refuses a robot this steering cannot drive
             except ValueError as exc:
                 self.notify("Planner options", str(exc))
                 options = planner.PlanOptions()

@@ -1,0 +1,114 @@
+"""The steering contract: every registered steering function, through the same properties.
+
+Exact endpoints, length = the sum of the driven segments, lower bounds ≤ length, the triangle
+inequality (shortest paths always satisfy it), symmetry where the robot may reverse or turn on
+the spot — and the registry is what every edge lists.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+from planner import STEERINGS, PlanOptions
+from planner._paths import path_end, path_length, pose_at, sample_path
+from planner._steer import state, steer_bound, steer_length, steer_path, steer_tight_bound
+
+RHO = 0.9
+coord = st.floats(-5, 5, allow_nan=False)
+angle = st.floats(-math.pi, math.pi, allow_nan=False)
+pose = st.tuples(coord, coord, angle)
+steerings = pytest.mark.parametrize("steering", list(STEERINGS.values()), ids=list(STEERINGS))
+
+
+def shortest(code, q0, q1):
+    kinds, lens = np.zeros(5, np.int8), np.zeros(5)
+    length = steer_path(code, *q0, *q1, RHO, kinds, lens)
+    return length, kinds, lens
+
+
+def as_state(q):
+    return state(*q, math.cos(q[2]), math.sin(q[2]), RHO)
+
+
+def distinct(q0, q1):
+    """Away from Dubins' discontinuity (a micrometre from the goal, rounding picks a loop)."""
+    return (math.hypot(q1[0] - q0[0], q1[1] - q0[1]) > 1e-6
+            or abs(math.remainder(q1[2] - q0[2], 2 * math.pi)) > 1e-6)
+
+
+@steerings
+@settings(max_examples=150, deadline=None)
+@given(q0=pose, q1=pose)
+def test_paths_end_exactly_and_their_length_is_the_segments(steering, q0, q1):
+    assume(distinct(q0, q1))
+    length, kinds, lens = shortest(steering.code, q0, q1)
+    end = path_end(*q0, kinds, lens, RHO)
+    assert end[:2] == pytest.approx(q1[:2], abs=1e-9)
+    assert math.remainder(end[2] - q1[2], 2 * math.pi) == pytest.approx(0.0, abs=1e-9)
+    assert path_length(kinds, lens) == pytest.approx(length, abs=1e-9)
+    assert length >= math.hypot(q1[0] - q0[0], q1[1] - q0[1]) - 1e-9
+    if not steering.reverses:
+        assert np.all(lens[kinds != 2] >= 0.0)
+
+
+@steerings
+@settings(max_examples=150, deadline=None)
+@given(q0=pose, q1=pose)
+def test_bounds_never_exceed_the_length_and_pruned_lengths_stay_above_the_bound(steering, q0,
+                                                                                q1):
+    assume(distinct(q0, q1))
+    a, b = as_state(q0), as_state(q1)
+    exact = steer_length(steering.code, a, b, RHO, math.inf)
+    assert exact == pytest.approx(shortest(steering.code, q0, q1)[0], abs=1e-9)
+    assert steer_bound(steering.code, a, b, RHO) <= exact + 1e-9
+    assert steer_tight_bound(steering.code, a, b, RHO) <= exact + 1e-9
+    cut = 0.5 * exact
+    assert steer_length(steering.code, a, b, RHO, cut) >= cut - 1e-9
+
+
+@steerings
+@settings(max_examples=150, deadline=None)
+@given(q0=pose, q1=pose, q2=pose)
+def test_triangle_inequality(steering, q0, q1, q2):
+    assume(distinct(q0, q1) and distinct(q1, q2) and distinct(q0, q2))
+    d = [shortest(steering.code, p, q)[0] for p, q in ((q0, q2), (q0, q1), (q1, q2))]
+    assert d[0] <= d[1] + d[2] + 1e-9
+
+
+@steerings
+@settings(max_examples=100, deadline=None)
+@given(q0=pose, q1=pose)
+def test_symmetric_where_the_robot_may_go_back(steering, q0, q1):
+    assume(distinct(q0, q1))
+    there, back = shortest(steering.code, q0, q1)[0], shortest(steering.code, q1, q0)[0]
+    if steering.reverses or steering.heading_free:
+        assert there == pytest.approx(back, abs=1e-9)
+
+
+@settings(max_examples=100, deadline=None)
+@given(q0=pose, q1=pose)
+def test_straight_rows_carry_the_direction_of_travel_and_no_curvature(q0, q1):
+    assume(math.hypot(q1[0] - q0[0], q1[1] - q0[1]) > 1e-3)
+    _, kinds, lens = shortest(STEERINGS["straight"].code, q0, q1)
+    rows = sample_path(*q0, kinds, lens, RHO, 0.05)
+    travel = math.atan2(q1[1] - q0[1], q1[0] - q0[0])
+    moving = np.hypot(*np.diff(rows[:, :2], axis=0).T) > 1e-9
+    headings = rows[1:][moving, 2]
+    assert np.allclose(np.cos(headings - travel), 1.0, atol=1e-9)
+    assert np.all(rows[:, 3] == 0.0) and np.all(rows[:, 4] == 1.0)
+    assert rows[-1, :2] == pytest.approx(q1[:2], abs=1e-9)
+    # halfway along, the robot faces its way; at the start it has not turned yet
+    half = pose_at(*q0, kinds, lens, RHO, 0.5 * path_length(kinds, lens))
+    assert math.cos(half[2] - travel) == pytest.approx(1.0)
+    assert pose_at(*q0, kinds, lens, RHO, 0.0)[2] == q0[2]
+
+
+def test_the_registry_is_what_the_options_accept():
+    schema = PlanOptions.model_json_schema()["properties"]["steering"]
+    assert schema["enum"] == list(STEERINGS)
+    assert {s.code for s in STEERINGS.values()} == set(range(len(STEERINGS)))
