@@ -51,9 +51,10 @@ class SimOptions(BaseModel):
         return SimSettings(**self.model_dump())
 
 
-def run_simulation(scenario: dict, options: SimOptions, track: TrackSource | None,
+def run_simulation(scenario, options: SimOptions, track: TrackSource | None,
                    log_path: Path, progress_path: Path) -> dict:
-    """Simulate, write the per-tick log CSV to ``log_path`` and return the JSON summary.
+    """Simulate a scenario (a `planner.Scenario` or its JSON object), write the per-tick log CSV
+    to ``log_path`` and return the JSON summary.
 
     While running, the simulated time reached is written to ``progress_path`` about every
     quarter second of wall time (replaced atomically, so a reader never sees half a number).
@@ -61,8 +62,10 @@ def run_simulation(scenario: dict, options: SimOptions, track: TrackSource | Non
     import planner as core
     from planner.sim import simulate
 
+    if not isinstance(scenario, core.Scenario):
+        scenario = core.parse_scenario(scenario)
     load_track = track_loader(track)
-    problem = core.compile_problem(core.parse_scenario(scenario), load_track=load_track)
+    problem = core.compile_problem(scenario, load_track=load_track)
     written = time.monotonic()
 
     def progress(frame) -> None:

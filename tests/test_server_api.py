@@ -255,8 +255,9 @@ def test_plan_by_id_on_an_uploaded_track(server):
 @pytest.mark.parametrize("body, words", [
     ({"scenario_id": "x", "scenario": {}}, "exactly one"),
     ({}, "exactly one"),
-    ({"scenario": {}, "time": 10}, "limit of 3"),
+    ({"scenario": scenario_dict("slalom"), "time": 10}, "limit of 3"),
     ({"scenario": {}, "time": -1}, "greater than 0"),
+    ({"scenario": {}, "time": -1}, "invalid scenario: name: Field required"),  # both named
     ({"scenario": {}, "planner": "prm"}, "rrtstar"),
     ({"scenario": {}, "goal_bias": 1.5}, "less than 1"),
     ({"scenario": {}, "colour": "red"}, "colour"),

@@ -16,7 +16,7 @@ from fastapi_offline import FastAPIOffline
 
 from app.server import routes_jobs, routes_plan, routes_scenarios, routes_simulations, routes_tracks
 from app.server.jobs import Planning
-from app.server.models import Health
+from app.server.models import INVALID_SCENARIO, Health
 from app.server.store import Store
 from planner import ScenarioError
 
@@ -77,6 +77,16 @@ class _TooLarge(Exception):
     pass
 
 
+def _scenario_message(error: dict) -> str:
+    """The message of an invalid inline scenario, led by its place in a list of them
+    ('scenarios[1]: invalid scenario: start: …')."""
+    loc = error["loc"]
+    if not any(isinstance(part, int) for part in loc):
+        return error["msg"]
+    where = "".join(f"[{part}]" if isinstance(part, int) else f".{part}" for part in loc[1:])
+    return f"{where.lstrip('.')}: {error['msg']}"
+
+
 def create_app(settings: ServerSettings) -> FastAPI:
     """The API app; the store and the worker pool live from its startup to its shutdown."""
 
@@ -106,6 +116,9 @@ def create_app(settings: ServerSettings) -> FastAPI:
     async def invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
         # Without the echoed input: it may hold NaN or infinity, which JSON cannot carry.
         errors = [{"loc": e["loc"], "msg": e["msg"], "type": e["type"]} for e in exc.errors()]
+        if errors and all(e["type"] == INVALID_SCENARIO for e in errors):
+            # Only an inline scenario is wrong: its one-line message, as for any ScenarioError.
+            return JSONResponse({"detail": _scenario_message(errors[0])}, status_code=422)
         return JSONResponse({"detail": errors}, status_code=422)
 
     @app.exception_handler(ScenarioError)

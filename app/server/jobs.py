@@ -26,6 +26,7 @@ from app.simulation import SimOptions, read_progress, run_simulation
 from planner.options import PlanOptions
 from planner.report import PlanReport
 from planner.rrt import warm_up
+from planner.scenario import Scenario
 
 __all__ = ["Planning", "first_line", "machine_workers"]
 
@@ -93,16 +94,16 @@ class Planning:
                 pool.shutdown(wait=False, cancel_futures=True)
             raise
 
-    async def check(self, scenario: dict, track: TrackSource | None) -> None:
+    async def check(self, scenario: Scenario, track: TrackSource | None) -> None:
         """Raise ScenarioError unless the scenario compiles (done in a worker: it may be slow)."""
         await self._call(check_scenario, scenario, track)
 
-    async def plan(self, scenario: dict, options: PlanOptions,
+    async def plan(self, scenario: Scenario, options: PlanOptions,
                    track: TrackSource | None) -> PlanReport:
         return await self._call(run_plan, scenario, options, max_time=self.max_plan_s,
                                 track=track)
 
-    def start_job(self, runs: list[tuple[dict, PlanOptions, TrackSource | None]]) -> str:
+    def start_job(self, runs: list[tuple[Scenario, PlanOptions, TrackSource | None]]) -> str:
         """Store a job and run it in the background; returns its id."""
         job_id = self.store.add_job(len(runs))
         self._jobs[job_id] = asyncio.get_running_loop().create_task(self._run(job_id, runs))
@@ -129,10 +130,10 @@ class Planning:
         finally:
             self._jobs.pop(job_id, None)
 
-    def start_simulation(self, scenario: dict, options: SimOptions,
+    def start_simulation(self, scenario: Scenario, options: SimOptions,
                          track: TrackSource | None) -> str:
         """Store a simulation and run it in the background on the pool; returns its id."""
-        sim_id = self.store.add_simulation(scenario["name"], options.model_dump())
+        sim_id = self.store.add_simulation(scenario.name, options.model_dump())
         task = self._simulate(sim_id, scenario, options, track)
         self._jobs[sim_id] = asyncio.get_running_loop().create_task(task)
         return sim_id
@@ -144,7 +145,8 @@ class Planning:
         """Simulated seconds a running simulation has reached."""
         return read_progress(self.sim_dir / f"{sim_id}.progress")
 
-    async def _simulate(self, sim_id: str, scenario: dict, options: SimOptions, track) -> None:
+    async def _simulate(self, sim_id: str, scenario: Scenario, options: SimOptions,
+                        track) -> None:
         progress = self.sim_dir / f"{sim_id}.progress"
         try:
             self.store.set_simulation(sim_id, "running")

@@ -6,13 +6,15 @@ planning options are `planner.PlanOptions`, from which the CLI's options are gen
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic_core import PydanticCustomError
 
 from app.simulation import SimOptions
 from planner.options import PlanOptions, Seed
 from planner.report import PlanReport
+from planner.scenario import Scenario, ScenarioError, parse_scenario
 
 Point = tuple[float, float]
 
@@ -24,6 +26,40 @@ SCENARIO_EXAMPLE = {
                   {"type": "box", "center": [7, 2], "size": [1.0, 0.6], "angle_deg": 30,
                    "motion": {"velocity": [0, 0.3]}}],
 }
+
+
+INVALID_SCENARIO = "invalid_scenario"  # the error type of a scenario that does not validate
+
+
+def _parse_scenario(data: Any) -> Any:
+    """A JSON object → `planner.Scenario` by `planner.parse_scenario`, the one validation of an
+    inline scenario: its one-line message (``invalid scenario: obstacles[0].radius: …``) is the
+    error's message, and app.py answers it as before. Anything else (a stored scenario's id, a
+    list) is left to the annotated type, so a list is "not a valid dictionary"."""
+    if not isinstance(data, dict):
+        return data
+    try:
+        return parse_scenario(data)
+    except ScenarioError as exc:
+        raise PydanticCustomError(INVALID_SCENARIO, "{detail}", {"detail": str(exc)}) from None
+
+
+# The request bodies' scenario: typed as `planner.Scenario`, so /openapi.json carries its schema.
+ScenarioBody = Annotated[Scenario, BeforeValidator(_parse_scenario)]
+ScenarioOrId = Annotated[str | Scenario, BeforeValidator(_parse_scenario)]
+
+
+class _OneScenario(BaseModel):
+    """A body with a scenario inline or by id. Exactly one is checked before the fields, so a
+    body with both is refused for that, whatever its inline scenario holds."""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _one_scenario(cls, data: Any) -> Any:
+        if isinstance(data, dict) and ((data.get("scenario") is None)
+                                       == (data.get("scenario_id") is None)):
+            raise ValueError("give exactly one of 'scenario' and 'scenario_id'")
+        return data
 
 
 class _Body(BaseModel):
@@ -100,21 +136,15 @@ class ScenarioRecord(BaseModel):
     scenario: dict[str, Any] = Field(description="as posted (FORMAT.md or the rich schema)")
 
 
-class PlanRequest(PlanOptions):
+class PlanRequest(PlanOptions, _OneScenario):
     """One plan: a scenario inline or by id, and the options of `trackstar plan`."""
 
     model_config = ConfigDict(
         json_schema_extra={"examples": [{"scenario": SCENARIO_EXAMPLE, "time": 0.5}]})
 
-    scenario: dict[str, Any] | None = Field(
+    scenario: ScenarioBody | None = Field(
         None, description="FORMAT.md or the rich schema (GET /scenarios/schema)")
     scenario_id: str | None = None
-
-    @model_validator(mode="after")
-    def _one_scenario(self) -> PlanRequest:
-        if (self.scenario is None) == (self.scenario_id is None):
-            raise ValueError("give exactly one of 'scenario' and 'scenario_id'")
-        return self
 
 
 class JobOptions(PlanOptions):
@@ -131,7 +161,7 @@ class JobOptions(PlanOptions):
 class JobRequest(_Body):
     """A batch: every scenario × every parameter set × every seed."""
 
-    scenarios: list[str | dict[str, Any]] = Field(
+    scenarios: list[ScenarioOrId] = Field(
         min_length=1, description="stored scenario ids or inline scenarios")
     parameters: list[JobOptions] = Field(default_factory=lambda: [JobOptions()], min_length=1)
     seeds: list[Seed] = Field(default_factory=lambda: [0], min_length=1)
@@ -162,22 +192,16 @@ class JobStatus(BaseModel):
     results: list[JobResult]
 
 
-class SimulationRequest(SimOptions):
+class SimulationRequest(SimOptions, _OneScenario):
     """One simulated run: a scenario inline or by id, and the options of `trackstar simulate`."""
 
     model_config = ConfigDict(json_schema_extra={"examples": [
         {"scenario": SCENARIO_EXAMPLE, "duration": 20, "seed": 1},
         {"scenario_id": "<a stored thesis-track scenario>", "laps": 2}]})
 
-    scenario: dict[str, Any] | None = Field(
+    scenario: ScenarioBody | None = Field(
         None, description="FORMAT.md or the rich schema (GET /scenarios/schema)")
     scenario_id: str | None = None
-
-    @model_validator(mode="after")
-    def _one_scenario(self) -> SimulationRequest:
-        if (self.scenario is None) == (self.scenario_id is None):
-            raise ValueError("give exactly one of 'scenario' and 'scenario_id'")
-        return self
 
     def options(self) -> SimOptions:
         return SimOptions(**self.model_dump(exclude={"scenario", "scenario_id"}))

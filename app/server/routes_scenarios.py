@@ -4,14 +4,14 @@ resolves a scenario (inline, a bundled name, or a stored id)."""
 from __future__ import annotations
 
 import json
-from typing import Annotated, Any
+from typing import Annotated
 
 from fastapi import APIRouter, Body, HTTPException, Request, Response
 
 import planner
 import tracks
 from app.planning import TrackSource
-from app.server.models import SCENARIO_EXAMPLE, ScenarioRecord
+from app.server.models import SCENARIO_EXAMPLE, ScenarioBody, ScenarioRecord
 
 router = APIRouter(tags=["scenarios"])
 
@@ -31,22 +31,24 @@ def stored_scenario(request: Request, scenario_id: str) -> dict:
     return record
 
 
-def resolve(request: Request, body: dict[str, Any] | str) -> tuple[dict, TrackSource | None]:
-    """A scenario (inline or a stored id) validated, with the uploaded track it names if any.
+def resolve(request: Request, scenario: planner.Scenario | str
+            ) -> tuple[planner.Scenario, TrackSource | None]:
+    """A scenario (inline, already validated with its body, or a stored id, validated here)
+    with the uploaded track it names if any.
 
     Raises ScenarioError (→ 422) naming the field, or 404 for an unknown scenario id.
     """
-    if isinstance(body, str):
-        body = stored_scenario(request, body)["scenario"]
-    scenario = planner.parse_scenario(body)
+    if isinstance(scenario, str):
+        scenario = planner.parse_scenario(stored_scenario(request, scenario)["scenario"])
     if (scenario.track is None or scenario.track.svg is not None
             or scenario.track.name in tracks.library_names()):
-        return body, None
+        return scenario, None
     row = request.app.state.store.track(scenario.track.name)
     if row is None:
         raise planner.ScenarioError(f"track.name: no track {scenario.track.name!r}: give a "
                                     f"library name or an uploaded track's id")
-    return body, TrackSource(id=row["id"], svg=row["svg"], path=row["path"], unit=row["unit"])
+    return scenario, TrackSource(id=row["id"], svg=row["svg"], path=row["path"],
+                                 unit=row["unit"])
 
 
 @router.get("/scenarios/schema")
@@ -58,14 +60,17 @@ def schema() -> dict:
 @router.post("/scenarios", response_model=ScenarioRecord, status_code=201)
 async def create_scenario(
     request: Request,
-    scenario: Annotated[dict[str, Any], Body(examples=[SCENARIO_EXAMPLE])],
+    scenario: Annotated[ScenarioBody, Body(examples=[SCENARIO_EXAMPLE])],
 ) -> ScenarioRecord:
     """Store a scenario (FORMAT.md or the rich schema) once it is known to be plannable: valid
     fields, start and goal free. Its track may be a library name or an uploaded track's id."""
-    body, track = resolve(request, scenario)
-    await request.app.state.planning.check(body, track)
-    scenario_id = request.app.state.store.add_scenario(body["name"], body)
-    return ScenarioRecord(id=scenario_id, name=body["name"], source="upload", scenario=body)
+    scenario, track = resolve(request, scenario)
+    await request.app.state.planning.check(scenario, track)
+    # Stored as posted, not as the parsed model (which would add every default): the JSON
+    # object FastAPI decoded the body into (Starlette keeps it; this does not decode again).
+    posted = await request.json()
+    scenario_id = request.app.state.store.add_scenario(scenario.name, posted)
+    return ScenarioRecord(id=scenario_id, name=scenario.name, source="upload", scenario=posted)
 
 
 @router.get("/scenarios", response_model=list[ScenarioRecord])

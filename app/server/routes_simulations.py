@@ -5,7 +5,6 @@ from __future__ import annotations
 from fastapi import APIRouter, HTTPException, Request
 from fastapi.responses import FileResponse
 
-import planner
 from app.server.models import SimulationCreated, SimulationRequest, SimulationStatus
 from app.server.routes_scenarios import resolve
 from planner.sim.laps import require_track
@@ -22,7 +21,7 @@ async def create_simulation(request: Request, body: SimulationRequest) -> Simula
     options = body.options()
     if options.laps is not None:
         try:
-            require_track(planner.parse_scenario(scenario))
+            require_track(scenario)
         except ValueError as exc:
             raise HTTPException(422, str(exc).removeprefix("--")) from None
     await request.app.state.planning.check(scenario, track)
