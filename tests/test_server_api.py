@@ -209,6 +209,46 @@ def test_bad_scenarios_are_422_naming_the_field(server, body, words):
         assert words in json.dumps(resp.json()["detail"]), (path, resp.text)
 
 
+def test_openapi_carries_the_scenario_schema_in_every_body(server):
+    spec = server.get("/openapi.json").json()
+    schemas = spec["components"]["schemas"]
+
+    def resolved(schema: dict) -> dict:
+        return schemas[schema["$ref"].rsplit("/", 1)[1]] if "$ref" in schema else schema
+
+    def body(path: str) -> dict:
+        return resolved(spec["paths"][path]["post"]["requestBody"]["content"]
+                        ["application/json"]["schema"])
+
+    scenario = schemas["Scenario"]
+    assert {"start", "goal", "obstacles", "vehicle", "track"} <= scenario["properties"].keys()
+    assert set(scenario["required"]) == {"name", "start", "goal"}
+    obstacles = scenario["properties"]["obstacles"]["items"]
+    kinds = {resolved(o)["properties"]["type"]["const"]: resolved(o) for o in obstacles["oneOf"]}
+    assert kinds.keys() == {"circle", "polygon", "box"}
+    assert all("motion" in kind["properties"] for kind in kinds.values())
+    motion = resolved(kinds["circle"]["properties"]["motion"]["anyOf"][0])
+    assert {"velocity", "waypoints", "follow_track"} <= motion["properties"].keys()
+    vehicle = resolved(scenario["properties"]["vehicle"])
+    assert {"radius", "footprint", "wheelbase"} <= vehicle["properties"].keys()
+    ref = {"$ref": "#/components/schemas/Scenario"}
+    for path in ("/api/v1/plan", "/api/v1/simulations"):
+        assert ref in body(path)["properties"]["scenario"]["anyOf"], path
+    assert ref in body("/api/v1/jobs")["properties"]["scenarios"]["items"]["anyOf"]
+    posted = spec["paths"]["/api/v1/scenarios"]["post"]["requestBody"]["content"]
+    assert posted["application/json"]["schema"]["$ref"] == ref["$ref"]
+    # The schema the API validates with is the one GET /scenarios/schema publishes.
+    published = server.client.get("/scenarios/schema").json()
+    assert published["properties"].keys() == scenario["properties"].keys()
+
+
+def test_minimal_format_scenarios_plan_inline(server):
+    for name in REFERENCE:
+        body = scenario_dict(name)
+        report = server.client.post("/plan", json={"scenario": body, "iterations": 50})
+        assert report.status_code == 200 and report.json()["scenario"] == name, report.text
+
+
 def test_plan_is_the_cli_plan_json(server):
     options = {"iterations": 800, "seed": 3, "planner": "rrt"}
     got = server.client.post("/plan", json={"scenario": scenario_dict("open_field"), **options})
