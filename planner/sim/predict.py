@@ -37,13 +37,18 @@ def predicted_world(base: World, sensing: Sensing, t0: float) -> World:
 
 
 def inflated(world: World, margin: float) -> World:
-    """The same world for a disc ``margin`` larger: every clearance drops by exactly ``margin``."""
+    """The same world for a footprint ``margin`` larger: every clearance drops by exactly
+    ``margin``.
+
+    Every check measures point clearances (the distance grid ``sdf`` holds them too) from each
+    footprint disc's centre and subtracts that disc's radius, so growing every disc's radius —
+    the one disc of a disc car, each covering disc of a rectangle — is the whole change;
+    ``geo[RADIUS]``, the smallest disc's radius that sampling reads, grows with them.
+    """
     if margin == 0.0:
         return world
     geo = world.geo.copy()
     geo[RADIUS] += margin
-    if hasattr(world, "discs"):  # footprint discs: the distance grid holds point distances
-        discs = world.discs.copy()
-        discs[:, 1] += margin
-        return world._replace(geo=geo, discs=discs)
-    return world._replace(geo=geo, sdf=world.sdf - margin)
+    discs = world.discs.copy()
+    discs[:, 1] += margin
+    return world._replace(geo=geo, discs=discs)
