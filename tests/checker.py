@@ -2,7 +2,10 @@
 
 Plain numpy, no planner code: it reconstructs the arc between consecutive path points from the
 two poses, densifies to 5 mm and tests every pose against the scenario's obstacles where they
-are at that instant.
+are at that instant. The car is FORMAT.md's disc of ``vehicle.radius`` or, in the rich schema
+(docs/planner.md), the rectangle ``vehicle.footprint`` at its exact outline (not the discs the
+planner covers it with): the pose is the rear axle, the rectangle runs ``rear_overhang`` behind
+it and ``length - rear_overhang`` ahead along the heading, ``width / 2`` to either side.
 """
 
 from __future__ import annotations
@@ -53,9 +56,107 @@ def _outline(ob: dict) -> np.ndarray:
     return corners @ rot.T + [cx, cy]
 
 
-def pose_valid(scn: dict, x: float, y: float, t: float | None) -> bool:
-    """FORMAT.md validity at time t (None: static obstacles only)."""
-    r = scn["vehicle"].get("radius", 0.0)
+def footprint(vehicle: dict) -> tuple[float, float, float] | None:
+    """A rectangle footprint as (length, width, rear_overhang), or None for a disc car. Without
+    ``rear_overhang`` the wheelbase sits in the middle of the length (docs/planner.md)."""
+    fp = vehicle.get("footprint")
+    if fp is None:
+        return None
+    length, width = fp["length"], fp["width"]
+    overhang = fp.get("rear_overhang")
+    if overhang is None:
+        overhang = max(length - vehicle.get("wheelbase", 0.44), 0.0) / 2
+    return length, width, overhang
+
+
+def car_corners(x: float, y: float, theta: float, rect: tuple[float, float, float]) -> np.ndarray:
+    """The (4, 2) corners of the footprint rectangle at the rear-axle pose (x, y, theta)."""
+    length, width, overhang = rect
+    c, s = math.cos(theta), math.sin(theta)
+    u = np.array([-overhang, length - overhang, length - overhang, -overhang])
+    v = np.array([-width / 2, -width / 2, width / 2, width / 2])
+    return np.column_stack([x + c * u - s * v, y + s * u + c * v])
+
+
+def _rect_distance(x, y, theta, rect, px, py):
+    """Distance from the points (px, py) to the solid rectangle (0 inside or on it)."""
+    length, width, overhang = rect
+    c, s = math.cos(theta), math.sin(theta)
+    dx, dy = np.subtract(px, x), np.subtract(py, y)
+    u, v = c * dx + s * dy, -s * dx + c * dy
+    du = np.maximum(np.maximum(-overhang - u, u - (length - overhang)), 0.0)
+    dv = np.maximum(np.abs(v) - width / 2, 0.0)
+    return np.hypot(du, dv)
+
+
+def _point_segment(px, py, seg):
+    """Distance from points to segments (broadcast; seg[..., :4] = x1, y1, x2, y2)."""
+    ax, ay, bx, by = seg[..., 0], seg[..., 1], seg[..., 2], seg[..., 3]
+    ex, ey = bx - ax, by - ay
+    u = np.clip(((px - ax) * ex + (py - ay) * ey) / np.maximum(ex * ex + ey * ey, 1e-300), 0, 1)
+    return np.hypot(ax + u * ex - px, ay + u * ey - py)
+
+
+def _segment_distance(p: np.ndarray, q: np.ndarray) -> float:
+    """The smallest distance between any segment of p (m, 4) and any of q (n, 4): 0 where two
+    cross; otherwise the closest pair has an endpoint of one of them."""
+    a, b = p[:, None, :], q[None, :, :]
+
+    def orient(ox, oy, ux, uy, wx, wy):
+        return (ux - ox) * (wy - oy) - (uy - oy) * (wx - ox)
+
+    o1 = orient(a[..., 0], a[..., 1], a[..., 2], a[..., 3], b[..., 0], b[..., 1])
+    o2 = orient(a[..., 0], a[..., 1], a[..., 2], a[..., 3], b[..., 2], b[..., 3])
+    o3 = orient(b[..., 0], b[..., 1], b[..., 2], b[..., 3], a[..., 0], a[..., 1])
+    o4 = orient(b[..., 0], b[..., 1], b[..., 2], b[..., 3], a[..., 2], a[..., 3])
+    if ((o1 * o2 < 0) & (o3 * o4 < 0)).any():
+        return 0.0
+    return float(min(_point_segment(a[..., 0], a[..., 1], b).min(),
+                     _point_segment(a[..., 2], a[..., 3], b).min(),
+                     _point_segment(b[..., 0], b[..., 1], a).min(),
+                     _point_segment(b[..., 2], b[..., 3], a).min()))
+
+
+def _rectangle_valid(scn: dict, rect, x: float, y: float, theta: float,
+                     t: float | None) -> bool:
+    """The rectangle inside the bounds (touching them is fine, as for the disc) and apart from
+    every obstacle (touching counts as collision)."""
+    corners = car_corners(x, y, theta, rect)
+    xmin, ymin, xmax, ymax = scn["bounds"]
+    if not ((corners[:, 0] >= xmin).all() and (corners[:, 0] <= xmax).all()
+            and (corners[:, 1] >= ymin).all() and (corners[:, 1] <= ymax).all()):
+        return False
+    edges = np.hstack([corners, np.roll(corners, -1, axis=0)])
+    for ob in scn["obstacles"]:
+        if t is None and ob.get("motion"):
+            continue
+        dx, dy = obstacle_offset(ob, t or 0.0)
+        if ob["type"] == "circle":
+            cx, cy = ob["center"]
+            if _rect_distance(x, y, theta, rect, cx + dx, cy + dy) <= ob["radius"]:
+                return False
+            continue
+        pts = _outline(ob) + [dx, dy]
+        # Apart iff the outlines neither cross nor touch and neither shape holds the other
+        # (then one point of each decides: the car's corner, the obstacle's first vertex).
+        if (_inside_even_odd(pts, *corners[0])
+                or _rect_distance(x, y, theta, rect, pts[0, 0], pts[0, 1]) <= 0.0
+                or _segment_distance(edges, np.hstack([pts, np.roll(pts, -1, axis=0)])) <= 0.0):
+            return False
+    return True
+
+
+def pose_valid(scn: dict, x: float, y: float, t: float | None,
+               theta: float | None = None) -> bool:
+    """FORMAT.md validity at time t (None: static obstacles only). A rectangle footprint
+    (rich schema) needs the heading ``theta``; a disc car ignores it."""
+    vehicle = scn.get("vehicle", {})
+    rect = footprint(vehicle)
+    if rect is not None:
+        if theta is None:
+            raise ValueError("a rectangle footprint is checked at a heading: give theta")
+        return _rectangle_valid(scn, rect, x, y, theta, t)
+    r = vehicle.get("radius", 0.0)
     xmin, ymin, xmax, ymax = scn["bounds"]
     if not (xmin + r <= x <= xmax - r and ymin + r <= y <= ymax - r):
         return False
@@ -106,7 +207,7 @@ def first_collision(scn: dict, path, step: float = 0.005) -> float | None:
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(dense[:, :2], axis=0).T))])
     timed = dense.shape[1] > 3
     for k, row in enumerate(dense):
-        if not pose_valid(scn, row[0], row[1], row[3] if timed else None):
+        if not pose_valid(scn, row[0], row[1], row[3] if timed else None, row[2]):
             return float(s[k])
     return None
 
