@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from planner.options import PlanOptions
     from planner.problem import Problem, compile_problem
-    from planner.rrt import Planner, Result, TreeEvents, TreeSnapshot
+    from planner.rrt import Planner, Result
     from planner.scenario import (
         Scenario,
         ScenarioError,
@@ -30,19 +30,21 @@ if TYPE_CHECKING:
         scenario_schema,
     )
     from planner.steering import STEERINGS
+    from planner.tree import Rewire, TreeEvents, TreeSnapshot
 
 _HOMES = {
     "PlanOptions": "options", "STEERINGS": "steering",
     "Problem": "problem", "compile_problem": "problem",
-    "Planner": "rrt", "Result": "rrt", "TreeEvents": "rrt", "TreeSnapshot": "rrt",
+    "Planner": "rrt", "Result": "rrt",
+    "Rewire": "tree", "TreeEvents": "tree", "TreeSnapshot": "tree",
     "Scenario": "scenario", "ScenarioError": "scenario", "bundled_scenario_path": "scenario",
     "load_scenario": "scenario", "parse_scenario": "scenario", "scenario_names": "scenario",
     "scenario_schema": "scenario",
 }
 
 __all__ = [
-    "PlanOptions", "Planner", "STEERINGS", "Problem", "Result", "Scenario", "ScenarioError", "TreeEvents",
-    "TreeSnapshot", "bundled_scenario_path", "compile_problem", "load_scenario",
+    "STEERINGS", "PlanOptions", "Planner", "Problem", "Result", "Rewire", "Scenario",
+    "ScenarioError", "TreeEvents", "TreeSnapshot", "bundled_scenario_path", "compile_problem", "load_scenario",
     "parse_scenario", "scenario_names", "scenario_schema", "solve",
 ]
 
@@ -59,7 +61,7 @@ def solve(scenario: Scenario | Problem | str | os.PathLike, *, time_limit: float
           iterations: int | None = None, **options) -> Result:
     """Plan a scenario once — a `Scenario`, a compiled `Problem`, a scenario file or a bundled
     scenario's name (``planner.solve("slalom", seed=3)``); ``options`` are `PlanOptions`
-    fields (``planner="rrt"``, ``steering="reeds-shepp"``, …)."""
+    fields (``planner="rrt"``, ``steering="straight"``, …)."""
     from planner.options import PlanOptions
     from planner.problem import Problem, compile_problem
     from planner.rrt import Planner

@@ -15,15 +15,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from planner import _kernel as K
-from planner._paths import path_length, pose_at, sample_path
+from planner._paths import pose_at, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
 from planner._world import path_clearances
 from planner.options import PLANNERS, PlanOptions
 from planner.problem import Problem
 from planner.steering import STEERINGS
+from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points
 
-__all__ = ["Planner", "Result", "TreeEvents", "TreeSnapshot", "warm_up"]
+__all__ = ["Planner", "Result", "warm_up"]
 
 CLEARANCE_SPACING_M = 0.005  # as FORMAT.md re-checks returned paths
 
@@ -55,25 +56,6 @@ class Result:
             if when <= t:
                 best = cost
         return best
-
-
-@dataclass(frozen=True)
-class TreeSnapshot:
-    """A copy of the tree for viewers: they never read the planner's live arrays."""
-
-    pose: np.ndarray
-    parent: np.ndarray
-    cost: np.ndarray
-    best_node: int
-
-
-@dataclass(frozen=True)
-class TreeEvents:
-    """What happened in a batch of iterations (see `_kernel` for the row columns)."""
-
-    rows: np.ndarray
-    near: np.ndarray
-    rewires: np.ndarray
 
 
 @dataclass
@@ -164,17 +146,10 @@ class Planner:
         return view
 
     def edge_points(self, node: int, count: int = 4) -> np.ndarray:
-        """(count + 1, 2) positions along the car path from ``node``'s parent to it (the root:
-        its position repeated), for drawing curved edges."""
+        """(count + 1, 2) positions along the local path from ``node``'s parent to it (the root:
+        its position repeated), for drawing curved edges; live, like `poses`."""
         t = self._tree
-        parent = int(t.parent[node])
-        if parent < 0:
-            return np.repeat(t.pose[node:node + 1, :2], count + 1, axis=0)
-        total = path_length(t.kinds[node], t.lens[node])
-        dense = sample_path(*t.pose[parent], t.kinds[node], t.lens[node], self.problem.rho,
-                            max(total / (4 * count), 1e-6))
-        pick = np.linspace(0, len(dense) - 1, count + 1).round().astype(int)
-        return dense[pick, :2]
+        return edge_points(t.pose, t.parent, t.kinds, t.lens, self.problem.rho, node, count)
 
     @property
     def finished(self) -> bool:
@@ -182,9 +157,10 @@ class Planner:
         return self.options.planner == "rrt" and self.solved
 
     def snapshot(self) -> TreeSnapshot:
-        n = self.nodes
-        t = self._tree
+        """A copy of the tree, for reading anywhere."""
+        n, t = self.nodes, self._tree
         return TreeSnapshot(t.pose[:n].copy(), t.parent[:n].copy(), t.cost[:n].copy(),
+                            t.kinds[:n].copy(), t.lens[:n].copy(), self.problem.rho,
                             int(t.cnt[K.BEST]))
 
     # -- running -----------------------------------------------------------------------------
@@ -202,9 +178,7 @@ class Planner:
         self._compute_time += took
         self._note_progress(done_before, took)
         if self._listeners:
-            n_rows, n_near, n_rw = events.cnt
-            batch = TreeEvents(events.rows[:n_rows].copy(), events.near[:n_near].copy(),
-                               events.rewires[:n_rw].copy())
+            batch = _named(events)
             for listener in self._listeners:
                 listener(batch)
 
@@ -338,6 +312,22 @@ class Planner:
             max_abs_curvature=float(np.abs(path[:, 3]).max()) if solved else None,
             cost_over_time=list(self._clock.cost_over_time), path=path,
             timed=self.problem.timed, options=self.options)
+
+
+def _named(ev: K.Events) -> TreeEvents:
+    """The kernel's event columns as `TreeEvents` fields."""
+    n_rows, n_near, n_rw = ev.cnt
+    rows = ev.rows[:n_rows]
+
+    def ints(col):
+        return rows[:, col].astype(np.int64)
+
+    return TreeEvents(
+        iteration=ints(K.EV_ITER), sample=rows[:, [K.EV_XR, K.EV_YR, K.EV_THR]],
+        nearest=ints(K.EV_NEAREST), new=ints(K.EV_NEW), parent=ints(K.EV_PARENT),
+        radius=rows[:, K.EV_RADIUS].copy(), best_cost=rows[:, K.EV_BEST].copy(),
+        rewires=[Rewire(*map(int, r)) for r in ev.rewires[:n_rw]],
+        _near=ev.near[:n_near].copy(), _near_span=ints([K.EV_NEAR_START, K.EV_NEAR_END]))
 
 
 def _step_lengths(pts: np.ndarray) -> np.ndarray:

@@ -87,16 +87,21 @@ def test_events_report_every_iteration_and_cost_nothing_without_listener():
     quiet.step(200)
     # Observing does not change the run.
     assert np.array_equal(watched.snapshot().pose, quiet.snapshot().pose)
-    rows = np.vstack([e.rows for e in seen])
-    assert len(rows) == 200 and list(rows[:, 0]) == list(range(1, 201))
-    rewires = np.vstack([e.rewires for e in seen if len(e.rewires)] or [np.zeros((0, 4))])
+    assert [int(i) for e in seen for i in e.iteration] == list(range(1, 201))
+    rewires = [r for e in seen for r in e.rewires]
     snap = watched.snapshot()
-    for it, node, old, new in rewires.astype(int):
-        assert old != new
-    if len(rewires):
-        # The last rewire of each node is its current parent.
-        last = {int(n): int(p) for _, n, _, p in rewires}
-        assert all(snap.parent[n] == p for n, p in last.items())
+    added = {int(e.new[0]): int(e.parent[0]) for e in seen if e.new[0] >= 0}
+    assert len(added) == snap.nodes - 1  # every node but the root, added once
+    for e in seen:
+        if e.new[0] >= 0:  # x_new's parent is x_min, one of its near nodes or x_nearest
+            assert e.parent[0] in set(e.near_of(0)) | {e.nearest[0]}
+            assert 0 < e.radius[0] < math.inf
+    for r in rewires:
+        assert r.old_parent != r.new_parent and added[r.new_parent] >= 0
+    assert rewires, "slalom rewires within 200 iterations"
+    # The last rewire of each node is its current parent; the others kept their first one.
+    last = {**added, **{r.node: r.new_parent for r in rewires}}
+    assert all(snap.parent[n] == p for n, p in last.items())
 
 
 def test_unsolvable_scenario_reports_unsolved():

@@ -43,7 +43,7 @@ def test_edge_points_run_from_parent_to_node_along_the_tree():
     snap = run.snapshot()
     for node in range(1, run.nodes):
         pts = run.edge_points(node, 4)
-        assert pts.shape == (5, 2)
+        assert pts.shape == (5, 2) and np.array_equal(pts, snap.edge_points(node, 4))
         assert np.allclose(pts[0], snap.pose[snap.parent[node], :2], atol=1e-6)
         assert np.allclose(pts[-1], snap.pose[node, :2], atol=1e-6)
         # Consecutive samples along a car path never jump further than the edge is long.
@@ -93,7 +93,7 @@ def test_extend_explains_what_each_iteration_really_did():
         before = run.nodes
         run.step(1)
         ev = events[-1]
-        info = StepInfo.from_row(ev.rows[-1], len(ev.rewires))
+        info = StepInfo.from_events(ev, -1, len(ev.rewires))
         line, note = explain(info, star=True)
         seen.add(line)
         if info.nearest < 0:
@@ -103,7 +103,7 @@ def test_extend_explains_what_each_iteration_really_did():
         else:
             assert line == (7 if len(ev.rewires) else 6)
             assert f"#{info.new}" in note and f"#{info.parent}" in note
-            assert run._tree.parent[info.new] == info.parent or len(ev.rewires)
+            assert run.snapshot().parent[info.new] == info.parent or len(ev.rewires)
     assert {6, 7} <= seen  # nodes were added, with and without rewires
     html = render(7, "a <note>")
     assert html.count("<mark>") == 1 and LINES[7].split(":")[0] in html

@@ -9,7 +9,7 @@ from __future__ import annotations
 import html
 from dataclasses import dataclass
 
-from planner import _kernel as K
+import planner
 
 __all__ = ["LINES", "StepInfo", "explain", "render"]
 
@@ -39,10 +39,10 @@ class StepInfo:
     radius: float
 
     @classmethod
-    def from_row(cls, row, n_rewired: int) -> StepInfo:
-        return cls(int(row[K.EV_ITER]), int(row[K.EV_NEAREST]), int(row[K.EV_NEW]),
-                   int(row[K.EV_PARENT]), max(int(row[K.EV_NEAR_END] - row[K.EV_NEAR_START]), 0),
-                   n_rewired, float(row[K.EV_RADIUS]))
+    def from_events(cls, ev: planner.TreeEvents, i: int, n_rewired: int) -> StepInfo:
+        """The batch's i-th iteration."""
+        return cls(int(ev.iteration[i]), int(ev.nearest[i]), int(ev.new[i]), int(ev.parent[i]),
+                   len(ev.near_of(i)), n_rewired, float(ev.radius[i]))
 
 
 def explain(info: StepInfo, star: bool) -> tuple[int, str]:

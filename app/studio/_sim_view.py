@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+import planner
 from app.studio._live_view import PATH_RGB, TREE_RGB
 from app.studio._scene import Z, _fill, obstacle_shape, polyline_segments, yaw_wxyz
 from planner.sim import SimSettings
@@ -130,19 +131,19 @@ class _Run:
         self.clearance = self.problem.clearance(x, y, f.t, theta)
         self.min_clearance = min(self.min_clearance, self.clearance)
         now = time.monotonic()
-        fresh = f.planner is not None and f.planner is not self._tree_of
+        fresh = f.tree is not None and f.tree is not self._tree_of
         if fresh and now - self._tree_at > TREE_S:
-            self._tree_of, self._tree_at = f.planner, now
-            self.tree = _tree_segments(f.planner)
+            self._tree_of, self._tree_at = f.tree, now
+            self.tree = _tree_segments(f.tree)
             self.tree_version += 1
         self.frame = f
 
 
-def _tree_segments(planner) -> np.ndarray:
+def _tree_segments(tree: planner.TreeSnapshot) -> np.ndarray:
     """Every edge as EDGE_PIECES straight pieces along its car path, at the tree's height."""
-    if planner.nodes < 2:
+    if tree.nodes < 2:
         return np.zeros((0, 2, 3), np.float32)
-    pts = np.stack([planner.edge_points(i, EDGE_PIECES) for i in range(1, planner.nodes)])
+    pts = np.stack([tree.edge_points(i, EDGE_PIECES) for i in range(1, tree.nodes)])
     seg = np.zeros((len(pts), EDGE_PIECES, 2, 3), np.float32)
     seg[:, :, 0, :2], seg[:, :, 1, :2] = pts[:, :-1], pts[:, 1:]
     seg[..., 2] = Z["tree"]
@@ -329,5 +330,5 @@ class SimView:
             f"| replans | {f.replans} |",
             f"| cycle ms (last, p50) | {f.cycle_ms:.1f}, {np.median(ms):.1f} |",
             f"| clearance (now, min) | {run.clearance:.3f} m, {run.min_clearance:.3f} m |",
-            f"| tree nodes | {f.planner.nodes if f.planner is not None else 0} |",
+            f"| tree nodes | {f.tree.nodes if f.tree is not None else 0} |",
         ])

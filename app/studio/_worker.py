@@ -18,7 +18,6 @@ import numpy as np
 import planner
 from app.studio._extend import StepInfo
 from app.studio._tree import SEG, EdgeChunks
-from planner import _kernel as K
 
 __all__ = ["Live", "PlannerWorker"]
 
@@ -136,33 +135,30 @@ class PlannerWorker:
         if ev is None:
             live.chunks.set(0, run.edge_points(0, SEG))
             return
-        for node in ev.rows[:, K.EV_NEW].astype(int):
-            if node >= 0:
-                live.chunks.set(node, run.edge_points(node, SEG))
+        for node in ev.new[ev.new >= 0]:
+            live.chunks.set(int(node), run.edge_points(node, SEG))
         now = time.monotonic()
         rewired = []
-        for _, node, _, _ in ev.rewires:
+        for rewire in ev.rewires:
+            node = rewire.node
             old = live.chunks.get(node)
             new = run.edge_points(node, SEG)
             live.chunks.set(node, new)
             live.flashes.append((now, old, new))
             rewired.append((old, new))
-        if self._stepping and len(ev.rows):
+        if self._stepping and len(ev):
             self._note_step(ev, rewired)
         self._note_best(now)
 
     def _note_step(self, ev: planner.TreeEvents, rewired: list) -> None:
-        row = ev.rows[-1]
         pose = self._run.poses
-        info = StepInfo.from_row(row, len(rewired))
-        near = ev.near[int(max(row[K.EV_NEAR_START], 0)):int(max(row[K.EV_NEAR_END], 0))]
+        info = StepInfo.from_events(ev, -1, len(rewired))
         self.live.step = {
-            "info": info, "star": self._star,
-            "x_rand": row[[K.EV_XR, K.EV_YR, K.EV_THR]].copy(),
+            "info": info, "star": self._star, "x_rand": ev.sample[-1].copy(),
             "nearest": pose[info.nearest].copy() if info.nearest >= 0 else None,
             "new": pose[info.new].copy() if info.new >= 0 else None,
             "parent_edge": (self.live.chunks.get(info.new) if info.new >= 0 else None),
-            "near": pose[near].copy(), "radius": info.radius, "rewired": rewired,
+            "near": pose[ev.near_of(-1)].copy(), "radius": info.radius, "rewired": rewired,
         }
         self.live.step_version += 1
 

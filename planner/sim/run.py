@@ -19,7 +19,7 @@ import numpy as np
 from planner._world import path_clearances
 from planner.options import PlanOptions
 from planner.problem import Problem, compile_problem, resolve_track
-from planner.rrt import Planner, warm_up
+from planner.rrt import warm_up
 from planner.scenario import Scenario
 from planner.sim.control import CONTROLLERS, Reference, Tracking, steer_command
 from planner.sim.fsm import Machine
@@ -30,6 +30,7 @@ from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
 from planner.sim.sensing import Sensing, mover_index, sense, true_offsets
 from planner.sim.vehicle import Limits, arc_step, limit_commands
+from planner.tree import TreeSnapshot
 
 __all__ = ["Frame", "SimRun", "SimSettings", "simulate"]
 
@@ -91,9 +92,9 @@ class SimRun:
 class Frame:
     """One control tick as a viewer sees it: the truth, what the car believes, what it does.
 
-    ``reference`` and ``planner`` are the live objects, not copies: a cycle builds new ones and
-    never changes them afterwards, so they may be read until the next frame arrives (the
-    planner's tree on the simulation's thread, i.e. inside the observer).
+    ``reference`` is the live object, not a copy: a cycle builds a new one and never changes it
+    afterwards, so it may be read until the next frame arrives. ``tree`` is a copy of the
+    replanner's tree, taken once per cycle, and may be kept.
     """
 
     t: float
@@ -105,7 +106,7 @@ class Frame:
     offsets: np.ndarray  # (n_obstacles, 2) true offsets at t, scenario order
     sensing: Sensing | None  # latest sensed offsets and velocities, motion order
     reference: Reference | None  # the committed trajectory the car tracks
-    planner: Planner | None  # the replanner's current tree
+    tree: TreeSnapshot | None  # the replanner's current tree
     cycles: int
     replans: int
     cycle_ms: float  # wall time of the latest cycle (NaN before the first)
@@ -169,6 +170,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     pending, next_cycle = None, 0.0 if fsm is None or fsm.planning else math.inf
     walls, cycles, replans, stops, was_stopped = [], [], 0, 0, False
     rows, lat = [], []
+    tree_of, tree = None, None  # the planner last shown to the observer, and its copy
     wall0 = time.perf_counter()
     reached = False
     for k in range(n_ticks + 1):
@@ -226,9 +228,12 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                      replanner.planner.nodes if replanner.planner else 0))
         lat.append(abs(e))
         if observer is not None:
+            if replanner.planner is not tree_of:  # a new cycle's tree: copy it once
+                tree_of = replanner.planner
+                tree = tree_of.snapshot() if tree_of is not None else None
             observer(Frame(t, (x, y, th), v_cmd, steer_cmd, want_steer, e,
                            true_offsets(problem.world, movers, t)[0], sensing, ref,
-                           replanner.planner, len(cycles), int(replans),
+                           tree, len(cycles), int(replans),
                            cycles[-1]["ms"] if cycles else math.nan))
         v, steer = v_cmd, steer_cmd
         if counter is not None:
