@@ -8,13 +8,14 @@ one, so a typo fails loudly instead of silently meaning a default.
 
 from __future__ import annotations
 
-import difflib
 import json
 import math
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, model_validator
+
+from planner.validation import StrictModel, describe, location, suggest
 
 __all__ = [
     "Scenario",
@@ -33,31 +34,12 @@ class ScenarioError(ValueError):
     """A scenario that cannot be planned, with a one-line message naming the field."""
 
 
-def _suggest(key: str, valid: list[str]) -> str:
-    close = difflib.get_close_matches(key, valid, n=1, cutoff=0.5)
-    return f" (did you mean '{close[0]}'?)" if close else f" (valid keys: {', '.join(valid)})"
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
-
-    @model_validator(mode="before")
-    @classmethod
-    def _known_keys(cls, data: Any) -> Any:
-        if isinstance(data, dict):
-            valid = sorted(cls.model_fields)
-            for key in data:
-                if key not in cls.model_fields:
-                    raise ValueError(f"unknown key '{key}'{_suggest(str(key), valid)}")
-        return data
-
-
 Pose = tuple[float, float, float]
 Point = tuple[float, float]
 Positive = Annotated[float, Field(gt=0)]
 
 
-class Footprint(_Strict):
+class Footprint(StrictModel):
     """An oriented rectangle (rich schema): the car's outline, with the rear axle — the pose's
     reference point — ``rear_overhang`` metres in front of the rear bumper."""
 
@@ -77,7 +59,7 @@ class Footprint(_Strict):
         return [(-overhang + half * (2 * i + 1), radius) for i in range(n)]
 
 
-class Vehicle(_Strict):
+class Vehicle(StrictModel):
     """The car: geometry for planning (v1), speed (v1.1) and limits for simulation (v1.2).
 
     The footprint is a disc of ``radius`` (FORMAT.md) or, in the rich schema, a rectangle.
@@ -115,12 +97,12 @@ class Vehicle(_Strict):
         return self.wheelbase / math.tan(math.radians(self.max_steer_deg))
 
 
-class GoalTolerance(_Strict):
+class GoalTolerance(StrictModel):
     position: Annotated[float, Field(gt=0)] = 0.25
     heading_deg: Annotated[float, Field(gt=0, le=180)] = 20.0
 
 
-class Motion(_Strict):
+class Motion(StrictModel):
     """Exactly one of: constant velocity, timed waypoints, or following a library track."""
 
     velocity: Point | None = None
@@ -142,7 +124,7 @@ class Motion(_Strict):
         return self
 
 
-class FollowTrack(_Strict):
+class FollowTrack(StrictModel):
     """Drive along the scenario's track centreline at ``speed`` from arc length ``start_s``."""
 
     speed: float
@@ -150,20 +132,20 @@ class FollowTrack(_Strict):
     horizon_s: Positive = 120.0
 
 
-class Circle(_Strict):
+class Circle(StrictModel):
     type: Literal["circle"]
     center: Point
     radius: Positive
     motion: Motion | None = None
 
 
-class Polygon(_Strict):
+class Polygon(StrictModel):
     type: Literal["polygon"]
     points: Annotated[list[Point], Field(min_length=3)]
     motion: Motion | None = None
 
 
-class Box(_Strict):
+class Box(StrictModel):
     """An oriented rectangle (rich schema): centre, size (length, width), heading in degrees."""
 
     type: Literal["box"]
@@ -182,7 +164,7 @@ class Box(_Strict):
 Obstacle = Annotated[Circle | Polygon | Box, Field(discriminator="type")]
 
 
-class TrackRef(_Strict):
+class TrackRef(StrictModel):
     """The drivable region (rich schema): a library track by name, or any track embedded as
     the Inkscape SVG `Track.to_svg` writes, so a scenario drawn or uploaded in the studio is
     self-contained (``name`` then only labels it)."""
@@ -192,7 +174,7 @@ class TrackRef(_Strict):
     svg: str | None = None
 
 
-class Scenario(_Strict):
+class Scenario(StrictModel):
     """A planning problem. Units: metres and radians, except the ``*_deg`` fields."""
 
     name: str
@@ -225,34 +207,21 @@ class Scenario(_Strict):
         return any(ob.motion is not None for ob in self.obstacles)
 
 
-def _location(loc: tuple) -> str:
-    """('obstacles', 2, 'circle', 'radius') → 'obstacles[2].radius' (drops union tags)."""
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        elif part in ("circle", "polygon", "box") or part.startswith("function-"):
-            continue
-        else:
-            out += f".{part}" if out else str(part)
-    return out
+_TAGS = ("circle", "polygon", "box")  # the obstacle union's tags, left out of locations
 
 
 def _describe(exc: ValidationError) -> str:
     err = exc.errors()[0]
-    where = _location(err["loc"])
-    msg = err["msg"].removeprefix("Value error, ")
     if err["type"] == "union_tag_invalid":
         tag = str(err.get("input", {}).get("type", ""))
-        msg = f"unknown obstacle type '{tag}'{_suggest(tag, ['box', 'circle', 'polygon'])}"
-    elif err["type"] == "union_tag_not_found":
-        msg = "obstacle without 'type' (circle, polygon or box)"
-    elif "waypoints" in err["loc"] and err["type"] in ("missing", "too_long", "tuple_type"):
-        where = where.split(".waypoints")[0] + ".waypoints"
-        msg = f"each waypoint is [t, dx, dy], got {err.get('input')!r}"
-    elif err["type"] == "finite_number":
-        msg = "must be a finite number (NaN and infinity are not allowed)"
-    return f"{where}: {msg}" if where else msg
+        where = location(err["loc"], _TAGS)
+        return f"{where}: unknown obstacle type '{tag}'{suggest(tag, sorted(_TAGS))}"
+    if err["type"] == "union_tag_not_found":
+        return f"{location(err['loc'], _TAGS)}: obstacle without 'type' (circle, polygon or box)"
+    if "waypoints" in err["loc"] and err["type"] in ("missing", "too_long", "tuple_type"):
+        where = location(err["loc"], _TAGS).split(".waypoints")[0] + ".waypoints"
+        return f"{where}: each waypoint is [t, dx, dy], got {err.get('input')!r}"
+    return describe(exc, _TAGS)
 
 
 def parse_scenario(data: Any) -> Scenario:

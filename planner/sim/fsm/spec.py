@@ -9,11 +9,12 @@ trace.
 
 from __future__ import annotations
 
-import difflib
 import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from planner.validation import suggest
 
 __all__ = ["FsmError", "Machine", "State", "Transition", "load_fsm", "parse_fsm"]
 
@@ -64,11 +65,6 @@ class Machine:
     states: dict[str, State] = field(default_factory=dict)
 
 
-def _suggest(name, options) -> str:
-    close = difflib.get_close_matches(str(name), list(options), n=1)
-    return f" (did you mean '{close[0]}'?)" if close else f" (use one of {', '.join(options)})"
-
-
 def _params(where: str, kind: str, given, spec) -> dict:
     required, optional = spec
     if given is None:
@@ -78,7 +74,7 @@ def _params(where: str, kind: str, given, spec) -> dict:
     for name in given:
         if name not in required and name not in optional:
             raise FsmError(f"{where}.params: unknown parameter '{name}' for {kind}"
-                           f"{_suggest(name, (*required, *optional))}")
+                           f"{suggest(name, (*required, *optional))}")
     for name in required:
         if name not in given:
             raise FsmError(f"{where}.params: missing parameter '{name}' for {kind}")
@@ -123,13 +119,13 @@ def _machine(data, where: str) -> Machine:
             raise FsmError(f"{prefix}states[{i}].id: duplicate id '{st['id']}'")
         ids.append(st["id"])
     if data["initial"] not in ids:
-        raise FsmError(f"{prefix}initial: unknown state '{data['initial']}'{_suggest(data['initial'], ids)}")
+        raise FsmError(f"{prefix}initial: unknown state '{data['initial']}'{suggest(data['initial'], ids)}")
     states = {}
     for i, st in enumerate(data["states"]):
         here = f"{prefix}states[{i}]"
         kind = st.get("type")
         if kind not in STATE_TYPES:
-            raise FsmError(f"{here}: unknown type '{kind}'{_suggest(kind, STATE_TYPES)}")
+            raise FsmError(f"{here}: unknown type '{kind}'{suggest(kind, STATE_TYPES)}")
         nested = None
         if kind == "StateMachine":
             nested = _machine({k: st.get(k) for k in ("initial", "states") if k in st}, here)
@@ -143,9 +139,9 @@ def _machine(data, where: str) -> Machine:
                 raise FsmError(f"{tw}: expected an object")
             tkind = tr.get("type")
             if tkind not in TRANSITION_TYPES:
-                raise FsmError(f"{tw}: unknown type '{tkind}'{_suggest(tkind, TRANSITION_TYPES)}")
+                raise FsmError(f"{tw}: unknown type '{tkind}'{suggest(tkind, TRANSITION_TYPES)}")
             if tr.get("to") not in ids:
-                raise FsmError(f"{tw}.to: unknown state '{tr.get('to')}'{_suggest(tr.get('to'), ids)}")
+                raise FsmError(f"{tw}.to: unknown state '{tr.get('to')}'{suggest(tr.get('to'), ids)}")
             transitions.append(Transition(tkind, _params(tw, tkind, tr.get("params"),
                                                          TRANSITION_TYPES[tkind]), tr["to"]))
         states[st["id"]] = State(st["id"], kind, params, tuple(transitions), nested)
