@@ -93,7 +93,7 @@ def _our_record(result, scenario: str, seed: int, budget: float, setup_s: float)
     Iterations per second of planning, as for OMPL, whose problem set-up is not timed either;
     the set-up time of ours (solve()'s wall time outside planning) is kept as `setup_s`.
     """
-    costs = [cost for t, cost in result.cost_over_time if t <= budget]
+    costs = [cost for t, cost, _ in result.cost_over_time if t <= budget]
     return {
         "scenario": scenario,
         "planner": OURS,

@@ -44,7 +44,7 @@ from planner._world import World, motion_free, static_clearance_estimate
 LANE_SHARE, LANE_SIGMA = 0.9, 0.25  # track scenarios: headings sampled along the lane
 NEAREST_BUCKETS = 256  # nearest's queue: half-cell buckets, the last one takes the rest
 # Counter indices.
-N, NGOAL, ITER, CHECKS, BEST, REWIRES, EVALS, FIRST_ITER, REFUSED = range(9)
+N, NGOAL, ITER, CHECKS, BEST, REWIRES, EVALS, IMPROVED, REFUSED = range(9)
 # Event row columns (only written when the event buffers are non-empty).
 EV_ITER, EV_XR, EV_YR, EV_THR, EV_NEAREST, EV_NEW, EV_PARENT, EV_NEAR_START, EV_NEAR_END, \
     EV_RADIUS, EV_BEST, EV_COLS = range(12)
@@ -64,6 +64,7 @@ class Tree(NamedTuple):
     cell_next: np.ndarray  # (cap,) int64
     grid: np.ndarray  # float64[5]: x0, y0, cell size, nx, ny
     goal_nodes: np.ndarray  # (cap,) int64
+    improved: np.ndarray  # (cap, 2): iteration and best cost at each improvement (cnt[IMPROVED])
     cnt: np.ndarray  # int64[9], see the counter indices
     rng: np.ndarray  # uint64[4]
     near: np.ndarray  # scratch (cap,) int64
@@ -89,7 +90,8 @@ def new_tree(capacity: int, grid: np.ndarray, rng: np.ndarray) -> Tree:
         lens=np.zeros((capacity, 5)), first_child=np.full(capacity, -1, np.int64),
         next_sibling=np.full(capacity, -1, np.int64), cell_head=np.full(nx * ny, -1, np.int64),
         cell_next=np.full(capacity, -1, np.int64), grid=grid,
-        goal_nodes=np.zeros(capacity, np.int64), cnt=np.zeros(9, np.int64), rng=rng,
+        goal_nodes=np.zeros(capacity, np.int64), improved=np.zeros((capacity, 2)),
+        cnt=np.zeros(9, np.int64), rng=rng,
         near=np.zeros(capacity, np.int64), near_len=np.zeros(capacity),
         near_key=np.zeros(capacity), stack=np.zeros(capacity, np.int64))
 
@@ -106,6 +108,7 @@ def grown(tree: Tree, capacity: int) -> Tree:
         kinds=pad(tree.kinds, 0), lens=pad(tree.lens, 0.0),
         first_child=pad(tree.first_child, -1), next_sibling=pad(tree.next_sibling, -1),
         cell_next=pad(tree.cell_next, -1), goal_nodes=pad(tree.goal_nodes, 0),
+        improved=pad(tree.improved, 0.0),
         near=np.zeros(capacity, np.int64), near_len=np.zeros(capacity),
         near_key=np.zeros(capacity), stack=np.zeros(capacity, np.int64))
 
@@ -445,9 +448,14 @@ def _update_best(tree: Tree) -> None:
         node = tree.goal_nodes[g]
         if best < 0 or tree.cost[node] < tree.cost[best]:
             best = node
-    if best >= 0 and tree.cnt[FIRST_ITER] < 0:
-        tree.cnt[FIRST_ITER] = tree.cnt[ITER]
     tree.cnt[BEST] = best
+    k = tree.cnt[IMPROVED]
+    # An improvement follows an added node, so there are never more than nodes (capacity).
+    if best >= 0 and (k == 0 or tree.cost[best] < tree.improved[k - 1, 1]) and k < len(
+            tree.improved):
+        tree.improved[k, 0] = tree.cnt[ITER]
+        tree.improved[k, 1] = tree.cost[best]
+        tree.cnt[IMPROVED] = k + 1
 
 
 @njit(cache=True)

@@ -28,7 +28,9 @@ class PlanReport(BaseModel):
     rewires: int
     refused_rewires: int = Field(description="rewires refused: the subtree would collide at "
                                              "its new arrival times")
-    cost_over_time: list[tuple[float, float]]
+    cost_over_time: list[tuple[float, float, int]] = Field(
+        description="[t_s, cost, iteration] at each improvement of the best cost: the iteration "
+                    "is exact for a seed, the time interpolated inside its batch")
     path: list[list[float]] = Field(description="[x, y, theta] (plus t with moving obstacles) "
                                                 "every ≤ 0.05 m from the start to the goal node")
     parameters: dict
@@ -51,7 +53,7 @@ def plan_report(result: Result, scenario_name: str, budget: dict) -> PlanReport:
         arrival_time_s=(float(result.path[-1, 5]) if result.timed and result.solved else None),
         planning_time_s=result.planning_time_s, rewires=result.rewires,
         refused_rewires=result.refused_rewires,
-        cost_over_time=[(round(t, 6), c) for t, c in result.cost_over_time], path=path,
+        cost_over_time=[(round(t, 6), c, i) for t, c, i in result.cost_over_time], path=path,
         parameters={**result.options.model_dump(), **budget,
                     "motion_check": "exact (clearance stepping)"},
     )

@@ -44,7 +44,7 @@ class Result:
     planning_time_s: float
     min_clearance_m: float | None
     max_abs_curvature: float | None
-    cost_over_time: list[tuple[float, float]]
+    cost_over_time: list[tuple[float, float, int]]  # (t_s, best cost, iteration) per improvement
     path: np.ndarray  # (n, 6): x, y, theta, curvature, direction, t
     timed: bool
     options: PlanOptions  # as resolved for the problem
@@ -52,7 +52,7 @@ class Result:
     def cost_at(self, t: float) -> float | None:
         """Best cost found within the first ``t`` seconds, or None."""
         best = None
-        for when, cost in self.cost_over_time:
+        for when, cost, _ in self.cost_over_time:
             if when <= t:
                 best = cost
         return best
@@ -62,7 +62,7 @@ class Result:
 class _Clock:
     started: float = field(default_factory=time.perf_counter)
     first_solution_s: float | None = None
-    cost_over_time: list[tuple[float, float]] = field(default_factory=list)
+    cost_over_time: list[tuple[float, float, int]] = field(default_factory=list)
 
     def elapsed(self) -> float:
         return time.perf_counter() - self.started
@@ -83,7 +83,6 @@ class Planner:
         grid = np.array([xmin, ymin, cell, nx, ny], dtype=float)
         self._tree = K.new_tree(capacity, grid, seed_state(s.seed))
         self._tree.cnt[K.BEST] = -1
-        self._tree.cnt[K.FIRST_ITER] = -1
         steering = STEERINGS[s.steering]
         P = np.zeros(K.NPARAMS)
         P[K.EPS], P[K.GAMMA], P[K.GOAL_BIAS] = s.eps, s.gamma, s.goal_bias
@@ -104,7 +103,6 @@ class Planner:
                                    np.zeros((0, 4), np.int64), np.zeros(3, np.int64))
         self._listeners: list[Callable[[TreeEvents], None]] = []
         self._clock = _Clock()
-        self._best_cost = math.inf
         self._compute_time = 0.0
 
     # -- observation -------------------------------------------------------------------------
@@ -189,18 +187,16 @@ class Planner:
                         np.zeros(3, np.int64))
 
     def _note_progress(self, iterations_before: int, batch_s: float) -> None:
-        cost = self.best_cost
-        if cost is None or cost >= self._best_cost:
-            return
-        now = self._compute_time
-        if self._clock.first_solution_s is None:
-            # Inside the batch, in proportion to its iterations: the kernel records the
-            # iteration of the first solution (FIRST_ITER).
-            done = max(self.iterations - iterations_before, 1)
-            share = (self._tree.cnt[K.FIRST_ITER] - iterations_before) / done
-            self._clock.first_solution_s = now - batch_s * (1.0 - min(max(share, 0.0), 1.0))
-        self._best_cost = cost
-        self._clock.cost_over_time.append((now, cost))
+        """Time-stamp the batch's improvements, which the kernel records by iteration: inside
+        the batch, in proportion to its iterations."""
+        t, clock = self._tree, self._clock
+        done = max(self.iterations - iterations_before, 1)
+        for iteration, cost in t.improved[len(clock.cost_over_time):t.cnt[K.IMPROVED]]:
+            share = min(max((iteration - iterations_before) / done, 0.0), 1.0)
+            when = self._compute_time - batch_s * (1.0 - share)
+            clock.cost_over_time.append((when, float(cost), int(iteration)))
+            if clock.first_solution_s is None:
+                clock.first_solution_s = when
 
     def solve(self, time_limit: float | None = 1.0, iterations: int | None = None) -> Result:
         """Run until the time or iteration budget is spent (RRT: until the first solution)."""

@@ -58,9 +58,12 @@ def test_same_seed_same_tree_other_seed_other_tree():
 
 def test_rrtstar_cost_never_increases():
     result = plan("open_field", iterations=6000)
-    costs = [c for _, c in result.cost_over_time]
+    costs = [c for _, c, _ in result.cost_over_time]
     assert len(costs) > 3
-    assert all(b <= a for a, b in zip(costs, costs[1:]))
+    assert all(b < a for a, b in zip(costs, costs[1:]))
+    assert costs[-1] == result.cost
+    iterations = [i for _, _, i in result.cost_over_time]
+    assert iterations == sorted(iterations) and iterations[-1] <= result.iterations
 
 
 def test_rrtstar_beats_rrt_on_average_over_seeds():
@@ -177,4 +180,18 @@ def test_first_solution_time_falls_inside_its_batch():
     result = run.result()
     assert result.solved
     assert 0.0 < result.time_to_first_solution_s < 0.5 * result.planning_time_s
-    assert result.cost_over_time[0][0] == result.planning_time_s  # improvements: batch ends
+    times = [t for t, _, _ in result.cost_over_time]
+    assert times[0] == result.time_to_first_solution_s and times == sorted(times)
+    assert times[-1] <= result.planning_time_s
+
+
+def test_the_cost_curve_is_the_same_for_a_seed_whatever_the_batches():
+    """Improvements are recorded by the kernel at their iteration: batch sizes do not matter."""
+    problem = planner.compile_problem(planner.parse_scenario(scenario_dict("slalom")))
+    one = planner.Planner(problem, planner.PlanOptions(seed=4))
+    one.step(3000)
+    many = planner.Planner(problem, planner.PlanOptions(seed=4))
+    for n in (1, 7, 500, 992, 1500):
+        many.step(n)
+    curve = [(c, i) for _, c, i in one.result().cost_over_time]
+    assert curve == [(c, i) for _, c, i in many.result().cost_over_time] and len(curve) > 3

@@ -30,12 +30,13 @@ cli = typer.Typer(
 
 
 def _register() -> None:
-    from app.cli import _plan, _serve, _simulate, _track
+    from app.cli import _plan, _serve, _simulate, _study, _track
 
     cli.add_typer(_track.track_cli, name="track")
     _plan.register(cli)
     _serve.register(cli)
     _simulate.register(cli)
+    _study.register(cli)
 
 
 _register()

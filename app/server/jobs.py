@@ -11,55 +11,22 @@ from __future__ import annotations
 
 import asyncio
 import functools
-import multiprocessing
-import os
-import signal
-import threading
-import time
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 from app.planning import TrackSource, check_scenario, run_plan
+from app.pool import first_line, machine_workers, start_pool, stop_pool
 from app.server.store import Store
 from app.simulation import SimOptions, read_progress, run_simulation
 from planner.options import PlanOptions
 from planner.report import PlanReport
-from planner.rrt import warm_up
 from planner.scenario import Scenario
 
-__all__ = ["Planning", "first_line", "machine_workers"]
+__all__ = ["Planning"]
 
 INTERRUPTED = "interrupted by a server shutdown"
 CRASHED = "interrupted: the server stopped before the job finished"
-PARENT_POLL_S = 0.5
-
-
-def _worker_start(server: int) -> None:
-    """Workers leave Ctrl-C to the server (which terminates them), end with it even when it is
-    killed (-9: nothing terminates them then), and load the kernels now."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    threading.Thread(target=_exit_with_parent, args=(server,), daemon=True,
-                     name="exit-with-server").start()
-    warm_up()
-
-
-def _exit_with_parent(server: int) -> None:
-    """End this worker, mid-run or idle, once its server is gone (re-parented away; this may
-    have happened before the worker got here)."""
-    while os.getppid() == server:
-        time.sleep(PARENT_POLL_S)
-    os._exit(1)
-
-
-def first_line(exc: BaseException) -> str:
-    text = str(exc).strip()
-    return text.splitlines()[0] if text else type(exc).__name__
-
-
-def machine_workers() -> int:
-    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
-               else os.cpu_count() or 1)
 
 
 class Planning:
@@ -76,12 +43,7 @@ class Planning:
         store.fail_unfinished(CRASHED)
 
     def _start_pool(self) -> ProcessPoolExecutor:
-        # spawn, not fork: the server process runs threads (uvicorn, viser, sqlite).
-        pool = ProcessPoolExecutor(self.workers, multiprocessing.get_context("spawn"),
-                                   initializer=_worker_start, initargs=(os.getpid(),))
-        for _ in range(self.workers):  # start every worker now, not at the first request
-            pool.submit(int)
-        return pool
+        return start_pool(self.workers)
 
     async def _call(self, fn, *args, **kwargs):
         loop = asyncio.get_running_loop()
@@ -172,9 +134,4 @@ class Planning:
         for task in list(self._jobs.values()):
             task.cancel()
         await asyncio.gather(*self._jobs.values(), return_exceptions=True)
-        processes = list(self.pool._processes.values())  # no public way to stop a running plan
-        self.pool.shutdown(wait=False, cancel_futures=True)
-        for process in processes:
-            process.terminate()
-        for process in processes:
-            await asyncio.to_thread(process.join, 2.0)
+        await asyncio.to_thread(stop_pool, self.pool)

@@ -1,0 +1,66 @@
+"""The process pool that plans off the caller's process: the server's jobs and the studies.
+
+Each worker loads the planner's compiled kernels once (its initializer), leaves Ctrl-C to its
+parent (which terminates it) and ends with its parent even when that is killed with -9 (nothing
+could terminate it then). Workers are spawned, not forked: the parent may run threads (uvicorn,
+viser, sqlite).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+import threading
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+from planner.rrt import warm_up
+
+__all__ = ["first_line", "machine_workers", "start_pool", "stop_pool"]
+
+PARENT_POLL_S = 0.5
+
+
+def _worker_start(parent: int) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_exit_with_parent, args=(parent,), daemon=True,
+                     name="exit-with-parent").start()
+    warm_up()
+
+
+def _exit_with_parent(parent: int) -> None:
+    """End this worker, mid-run or idle, once its parent is gone (re-parented away; this may
+    have happened before the worker got here)."""
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL_S)
+    os._exit(1)
+
+
+def start_pool(workers: int) -> ProcessPoolExecutor:
+    """A pool of ``workers`` processes, every one started now (not at the first task)."""
+    pool = ProcessPoolExecutor(workers, multiprocessing.get_context("spawn"),
+                               initializer=_worker_start, initargs=(os.getpid(),))
+    for _ in range(workers):
+        pool.submit(int)
+    return pool
+
+
+def stop_pool(pool: ProcessPoolExecutor) -> None:
+    """Stop now: queued tasks are cancelled and running ones terminated with their workers."""
+    processes = list(pool._processes.values())  # no public way to stop a running plan
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.terminate()
+    for process in processes:
+        process.join(2.0)
+
+
+def first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
+def machine_workers() -> int:
+    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+               else os.cpu_count() or 1)

@@ -1,0 +1,115 @@
+"""A study's results: one SQLite file, written run by run, readable by others while it grows.
+
+Each finished run is committed at once (WAL mode), so Ctrl-C, a crash or ``kill -9`` loses no
+finished run and leaves a valid database. The schema (docs/studies.md) is versioned with
+``PRAGMA user_version``. Only the study's driver writes; a run that failed is stored with its
+error and replaced when the study is run again.
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime as dt
+import sqlite3
+from importlib.metadata import version
+from pathlib import Path
+
+from app.study.spec import Run
+
+__all__ = ["COLUMNS", "Results", "StudyMismatch"]
+
+SCHEMA_VERSION = 1
+KEY = ("scenario", "planner", "steering", "parameters", "budget_iterations", "budget_time_s",
+       "seed")
+OUTCOME = ("solved", "cost", "time_to_first_solution_s", "iterations", "nodes",
+           "collision_checks", "min_clearance_m", "iterations_per_s", "wall_s", "error")
+COLUMNS = ("id", "study", *KEY, *OUTCOME, "trackstar_version", "finished_at")
+
+_SCHEMA = f"""
+CREATE TABLE IF NOT EXISTS study (
+    name TEXT PRIMARY KEY, file TEXT NOT NULL, started_at TEXT NOT NULL,
+    trackstar_version TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS runs (
+    id INTEGER PRIMARY KEY, study TEXT NOT NULL, scenario TEXT NOT NULL, planner TEXT NOT NULL,
+    steering TEXT NOT NULL, parameters TEXT NOT NULL, budget_iterations INTEGER,
+    budget_time_s REAL, seed INTEGER NOT NULL, solved INTEGER, cost REAL,
+    time_to_first_solution_s REAL, iterations INTEGER, nodes INTEGER, collision_checks INTEGER,
+    min_clearance_m REAL, iterations_per_s REAL, wall_s REAL, error TEXT,
+    trackstar_version TEXT NOT NULL, finished_at TEXT NOT NULL);
+CREATE UNIQUE INDEX IF NOT EXISTS runs_key ON runs (study, scenario, planner, steering,
+    parameters, IFNULL(budget_iterations, -1), IFNULL(budget_time_s, -1), seed);
+CREATE TABLE IF NOT EXISTS cost_over_time (
+    run_id INTEGER NOT NULL REFERENCES runs (id) ON DELETE CASCADE, iteration INTEGER,
+    t_s REAL NOT NULL, cost REAL NOT NULL);
+CREATE INDEX IF NOT EXISTS cost_over_time_run ON cost_over_time (run_id);
+PRAGMA user_version = {SCHEMA_VERSION};
+"""
+
+
+class StudyMismatch(ValueError):
+    """The results file belongs to another study."""
+
+
+class Results:
+    """``DIR/results.sqlite`` of one study."""
+
+    def __init__(self, directory: Path, study: str, file_text: str) -> None:
+        directory.mkdir(parents=True, exist_ok=True)
+        self.path = directory / "results.sqlite"
+        self.study = study
+        self.version = version("trackstar")
+        self._db = sqlite3.connect(self.path, isolation_level=None)
+        self._db.execute("PRAGMA journal_mode = WAL")
+        self._db.execute("PRAGMA foreign_keys = ON")
+        self._db.executescript(_SCHEMA)
+        other = self._db.execute("SELECT name FROM study WHERE name != ?", (study,)).fetchone()
+        if other is not None:
+            self._db.close()
+            raise StudyMismatch(f"{self.path} holds study '{other[0]}', not '{study}': give "
+                                f"another --out")
+        self._db.execute(
+            "INSERT INTO study VALUES (?, ?, ?, ?) ON CONFLICT (name) DO UPDATE SET "
+            "file = excluded.file", (study, file_text, _now(), self.version))
+
+    def done(self) -> set[tuple]:
+        """Keys of the runs that finished (failed runs are done again)."""
+        rows = self._db.execute(f"SELECT {', '.join(KEY)} FROM runs WHERE study = ? AND error "
+                                f"IS NULL", (self.study,))
+        return set(rows)
+
+    def add(self, run: Run, outcome: dict, cost_over_time: list) -> None:
+        """Store one run and its cost curve in one transaction (replacing a failed attempt)."""
+        key = run.key
+        with self._db:  # BEGIN … COMMIT
+            self._db.execute("BEGIN")
+            self._db.execute(
+                "DELETE FROM runs WHERE study = ? AND scenario = ? AND planner = ? AND "
+                "steering = ? AND parameters = ? AND budget_iterations IS ? AND budget_time_s "
+                "IS ? AND seed = ?", (self.study, *key))
+            cur = self._db.execute(
+                f"INSERT INTO runs ({', '.join(COLUMNS[1:])}) VALUES "
+                f"({', '.join('?' * (len(COLUMNS) - 1))})",
+                (self.study, *key, *(outcome.get(c) for c in OUTCOME), self.version, _now()))
+            self._db.executemany("INSERT INTO cost_over_time VALUES (?, ?, ?, ?)",
+                                 [(cur.lastrowid, *row) for row in cost_over_time])
+
+    def count(self) -> tuple[int, int]:
+        """(runs stored, of which failed)."""
+        return self._db.execute("SELECT COUNT(*), COUNT(error) FROM runs WHERE study = ?",
+                                (self.study,)).fetchone()
+
+    def write_csv(self, path: Path) -> None:
+        """The `runs` table as CSV: a header of the column names, one line per run."""
+        rows = self._db.execute(f"SELECT {', '.join(COLUMNS)} FROM runs WHERE study = ? "
+                                f"ORDER BY id", (self.study,))
+        with path.open("w", newline="", encoding="utf-8") as out:
+            writer = csv.writer(out)
+            writer.writerow(COLUMNS)
+            writer.writerows(rows)
+
+    def close(self) -> None:
+        self._db.close()
+
+
+def _now() -> str:
+    return dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")

@@ -1,0 +1,105 @@
+"""Run a study's remaining runs on a process pool, storing each the moment it finishes."""
+
+from __future__ import annotations
+
+import sys
+import time
+from concurrent.futures import FIRST_COMPLETED, wait
+from dataclasses import dataclass
+from pathlib import Path
+
+from tqdm import tqdm
+
+import planner
+from app.planning import run_plan
+from app.pool import first_line, start_pool, stop_pool
+from app.study.results import Results
+from app.study.spec import Run, Study
+
+__all__ = ["Summary", "execute", "run_study"]
+
+
+@dataclass(frozen=True)
+class Summary:
+    """What `trackstar study --json` prints."""
+
+    study: str
+    out: str
+    total: int
+    done: int  # runs stored and finished, over all invocations
+    skipped: int  # runs found already stored at the start
+    failed: int
+    wall_s: float
+    results: str
+    csv: str
+    report: str | None
+
+
+def execute(scenario: planner.Scenario, run: Run) -> tuple[dict, list]:
+    """One run, in a worker: its outcome row and its cost curve (iteration, t_s, cost) — the
+    numbers `trackstar plan --json` prints for the same options."""
+    started = time.perf_counter()
+    try:
+        report = run_plan(scenario, run.options())
+    except Exception as exc:  # noqa: BLE001  (stored with the run; the study goes on)
+        return {"error": first_line(exc), "wall_s": time.perf_counter() - started}, []
+    rate = report.iterations / report.planning_time_s if report.planning_time_s > 0 else None
+    outcome = {
+        "solved": int(report.solved), "cost": report.cost,
+        "time_to_first_solution_s": report.time_to_first_solution_s,
+        "iterations": report.iterations, "nodes": report.nodes,
+        "collision_checks": report.collision_checks, "min_clearance_m": report.min_clearance_m,
+        "iterations_per_s": rate, "wall_s": time.perf_counter() - started}
+    return outcome, [(i, t, cost) for t, cost, i in report.cost_over_time]
+
+
+def run_study(study: Study, out: Path, workers: int) -> Summary:
+    """Run what ``out`` does not hold yet. Ctrl-C stops the workers and raises
+    KeyboardInterrupt once every finished run is stored."""
+    started = time.perf_counter()
+    results = Results(out, study.name, study.text)
+    try:
+        done = results.done()
+        todo = [run for run in study.runs if run.key not in done]
+        skipped = len(study.runs) - len(todo)
+        if skipped:
+            print(f"{skipped} of {len(study.runs)} runs already in {results.path}: skipped",
+                  file=sys.stderr)
+        if todo:
+            _run_on_pool(study, todo, results, min(workers, len(todo)))
+        stored, failed = results.count()
+        results.write_csv(out / "results.csv")
+    finally:
+        results.close()
+    return Summary(study.name, str(out), len(study.runs), stored - failed, skipped, failed,
+                   time.perf_counter() - started, str(results.path), str(out / "results.csv"),
+                   None)
+
+
+def _run_on_pool(study: Study, todo: list[Run], results: Results, workers: int) -> None:
+    bar = tqdm(total=len(todo), desc=study.name, unit="run", file=sys.stderr,
+               disable=not sys.stderr.isatty())
+    pool = start_pool(workers)
+    pending: dict = {}
+    queue = iter(todo)
+    solved = 0
+    try:
+        while True:
+            while len(pending) < 2 * workers:  # a short queue: Ctrl-C cancels little work
+                run = next(queue, None)
+                if run is None:
+                    break
+                pending[pool.submit(execute, study.scenarios[run.scenario], run)] = run
+            if not pending:
+                break
+            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for future in finished:
+                run = pending.pop(future)
+                outcome, curve = future.result()
+                results.add(run, outcome, curve)
+                solved += outcome.get("solved", 0)
+                bar.update()
+                bar.set_postfix(solved=solved, refresh=False)
+    finally:
+        stop_pool(pool)
+        bar.close()

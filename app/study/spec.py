@@ -1,0 +1,187 @@
+"""The study file: YAML or JSON, validated before anything runs, expanded into runs.
+
+A run is one (scenario, planner, steering, parameter point, budget, seed); its key identifies
+it in the results, so a resumed or extended study redoes nothing. A parameter that a planner
+does not have (RRT has no γ, k or informed sampling) is dropped from its points, so such a
+planner runs once per point of the parameters it has.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import yaml
+from pydantic import Field, ValidationError, field_validator, model_validator
+
+import planner
+from planner.options import PLANNERS, PlanOptions, PositiveFinite, Seed
+from planner.steering import STEERINGS, SteeringName
+from planner.validation import StrictModel, describe, suggest
+
+__all__ = ["PARAMETERS", "Run", "Study", "StudyError", "load_study"]
+
+# The axes a study may sweep: `trackstar plan`'s options, under the same names.
+PARAMETERS = ("eps", "gamma", "k_rrt", "goal_bias", "informed", "speed")
+_RRTSTAR_ONLY = ("gamma", "k_rrt", "informed")
+
+Count = Annotated[int, Field(ge=1)]
+
+
+class StudyError(ValueError):
+    """A study file that cannot run, with a one-line message naming the key."""
+
+
+def _as_list(value):
+    return value if isinstance(value, list) else [value]
+
+
+class Budget(StrictModel):
+    """Per run: an iteration budget, a time budget, or both (whichever comes first); either
+    may be a list, another axis of the grid."""
+
+    iterations: Annotated[list[Count], Field(min_length=1)] | None = None
+    time_s: Annotated[list[PositiveFinite], Field(min_length=1)] | None = None
+
+    @field_validator("iterations", "time_s", mode="before")
+    @classmethod
+    def _lists(cls, value: Any) -> Any:
+        return None if value is None else _as_list(value)
+
+    @model_validator(mode="after")
+    def _some(self) -> Budget:
+        if self.iterations is None and self.time_s is None:
+            raise ValueError("give iterations, time_s or both")
+        return self
+
+    def points(self) -> list[tuple[int | None, float | None]]:
+        return list(itertools.product(self.iterations or [None], self.time_s or [None]))
+
+
+class StudyFile(StrictModel):
+    """The keys of a study file (docs/studies.md)."""
+
+    name: Annotated[str, Field(pattern=r"^[A-Za-z0-9_.-]+$", max_length=100)]
+    description: str | None = None
+    kind: Literal["plan"] = "plan"
+    scenarios: Annotated[list[str], Field(min_length=1)]
+    planners: Annotated[list[Literal[PLANNERS]], Field(min_length=1)]
+    steering: Annotated[list[SteeringName], Field(min_length=1)] = [next(iter(STEERINGS))]
+    parameters: dict[str, Annotated[list[Any], Field(min_length=1)]] = {}
+    seeds: Annotated[list[Seed], Field(min_length=1)] = [0]
+    budget: Budget
+
+    @field_validator("seeds", mode="before")
+    @classmethod
+    def _count(cls, seeds: Any) -> Any:
+        """``seeds: N`` means 0..N-1."""
+        if isinstance(seeds, int) and not isinstance(seeds, bool):
+            if seeds < 1:
+                raise ValueError(f"a count of seeds is at least 1, got {seeds}")
+            return list(range(seeds))
+        return seeds
+
+    @field_validator("parameters")
+    @classmethod
+    def _values(cls, parameters: dict) -> dict:
+        """Known names, and each value as `PlanOptions` validates it, so the study and
+        `trackstar plan` agree."""
+        for key, values in parameters.items():
+            if key not in PARAMETERS:
+                raise ValueError(f"unknown parameter '{key}'{suggest(key, PARAMETERS)}")
+            for i, value in enumerate(values):
+                try:
+                    PlanOptions(**{key: value})
+                except ValidationError as exc:
+                    msg = exc.errors()[0]["msg"]
+                    raise ValueError(f"{key}[{i}] = {value!r}: {msg}") from None
+        return parameters
+
+
+@dataclass(frozen=True)
+class Run:
+    scenario: str  # the scenario's name
+    planner: str
+    steering: str
+    parameters: dict = field(hash=False, compare=False)
+    budget_iterations: int | None
+    budget_time_s: float | None
+    seed: int
+
+    @property
+    def parameters_json(self) -> str:
+        return json.dumps(self.parameters, sort_keys=True)
+
+    @property
+    def key(self) -> tuple:
+        return (self.scenario, self.planner, self.steering, self.parameters_json,
+                self.budget_iterations, self.budget_time_s, self.seed)
+
+    def options(self) -> PlanOptions:
+        """The options `trackstar plan` would take for this run."""
+        return PlanOptions(planner=self.planner, steering=self.steering, seed=self.seed,
+                           iterations=self.budget_iterations, time=self.budget_time_s,
+                           **self.parameters)
+
+
+@dataclass(frozen=True)
+class Study:
+    """A validated study: its file's text, its scenarios (by name) and its runs."""
+
+    name: str
+    text: str
+    scenarios: dict[str, planner.Scenario]
+    runs: list[Run]
+
+
+def _points(parameters: dict, planner_name: str) -> list[dict]:
+    keys = [k for k in parameters if planner_name == "rrtstar" or k not in _RRTSTAR_ONLY]
+    return [dict(zip(keys, values, strict=True))
+            for values in itertools.product(*(parameters[k] for k in keys))]
+
+
+def _scenario(source: str, study: Path, where: str) -> planner.Scenario:
+    """A path relative to the study file, else a bundled scenario's name."""
+    path = study.parent / source
+    try:
+        return planner.load_scenario(path if path.is_file() else source)
+    except planner.ScenarioError as exc:
+        raise StudyError(f"{study}: {where} ({source}): {exc}") from None
+
+
+def load_study(path: str | Path) -> Study:
+    """Read, validate and expand a study file; raises StudyError naming the key."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise StudyError(f"cannot read study {path}: {exc}") from None
+    try:
+        data = (json.loads(text) if path.suffix == ".json" else yaml.safe_load(text))
+    except (json.JSONDecodeError, yaml.YAMLError) as exc:
+        raise StudyError(f"{path}: not valid {'JSON' if path.suffix == '.json' else 'YAML'} "
+                         f"({str(exc).splitlines()[0]})") from None
+    if not isinstance(data, dict):
+        raise StudyError(f"{path}: a study is a mapping of keys, got {type(data).__name__}")
+    try:
+        spec = StudyFile.model_validate(data)
+    except ValidationError as exc:
+        raise StudyError(f"{path}: {describe(exc)}") from None
+    scenarios = {}
+    for i, source in enumerate(spec.scenarios):
+        scenario = _scenario(source, path, f"scenarios[{i}]")
+        scenarios.setdefault(scenario.name, scenario)
+    seeds = list(range(spec.seeds)) if isinstance(spec.seeds, int) else spec.seeds
+    runs, seen = [], set()
+    for name, planner_name, steering in itertools.product(scenarios, spec.planners,
+                                                          spec.steering):
+        for point in _points(spec.parameters, planner_name):
+            for (iterations, time_s), seed in itertools.product(spec.budget.points(), seeds):
+                run = Run(name, planner_name, steering, point, iterations, time_s, seed)
+                if run.key not in seen:
+                    seen.add(run.key)
+                    runs.append(run)
+    return Study(spec.name, text, scenarios, runs)

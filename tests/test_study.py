@@ -1,0 +1,152 @@
+"""`trackstar study`: a grid of plans from one file, stored run by run, resumable."""
+
+from __future__ import annotations
+
+import csv
+import json
+import signal
+import sqlite3
+import subprocess
+import time
+
+import pytest
+
+STUDY = """\
+name: small
+description: two scenarios, two planners, two eps, two seeds
+scenarios: [open_field, ./my/slalom.json]
+planners: [rrt, rrtstar]
+parameters:
+  eps: [1.0, 2.5]
+seeds: 2
+budget:
+  iterations: 400
+"""
+DETERMINISTIC = ("scenario", "planner", "steering", "parameters", "budget_iterations", "seed",
+                 "solved", "cost", "iterations", "nodes", "collision_checks", "min_clearance_m")
+
+
+def trackstar(*args, cwd=None, timeout=120):
+    return subprocess.run(["trackstar", *args], capture_output=True, text=True, cwd=cwd,
+                          timeout=timeout)
+
+
+@pytest.fixture
+def study_file(tmp_path):
+    """The study beside a scenario file it names by a relative path."""
+    from conftest import scenario_dict
+
+    (tmp_path / "my").mkdir()
+    (tmp_path / "my" / "slalom.json").write_text(json.dumps(scenario_dict("slalom")))
+    path = tmp_path / "small.yaml"
+    path.write_text(STUDY)
+    return path
+
+
+def rows(out, columns=DETERMINISTIC):
+    with sqlite3.connect(out / "results.sqlite") as db:
+        return sorted(db.execute(f"SELECT {', '.join(columns)} FROM runs"))
+
+
+def test_a_study_runs_its_grid_and_stores_the_numbers_plan_prints(study_file, tmp_path):
+    started = time.perf_counter()
+    out = trackstar("study", str(study_file), "--json", cwd=tmp_path / "my")  # a path relative to the file
+    assert out.returncode == 0, out.stderr
+    summary = json.loads(out.stdout)
+    assert time.perf_counter() - started < 60
+    # 2 scenarios × (2 planners × 2 eps) × 2 seeds
+    assert {k: summary[k] for k in ("study", "total", "done", "skipped", "failed")} == {
+        "study": "small", "total": 16, "done": 16, "skipped": 0, "failed": 0}
+    default_out = tmp_path / "my" / "studies" / "small"
+    assert summary["out"] == "studies/small" and (default_out / "results.csv").is_file()
+    table = rows(default_out)
+    assert len(table) == 16 and len({r[:6] for r in table}) == 16
+    # A row is what `trackstar plan` prints for the same settings.
+    for scenario, planner_name, _, params, iterations, seed, *numbers in table[::5]:
+        source = "open_field" if scenario == "open_field" else str(tmp_path / "my/slalom.json")
+        plan = json.loads(trackstar(
+            "plan", source, "--planner", planner_name, "--eps", str(json.loads(params)["eps"]),
+            "--iterations", str(iterations), "--seed", str(seed), "--json").stdout)
+        assert numbers == [int(plan["solved"]), plan["cost"], plan["iterations"], plan["nodes"],
+                           plan["collision_checks"], plan["min_clearance_m"]]
+    # The CSV is the table; the cost curves end at each run's cost and never rise.
+    with (default_out / "results.csv").open() as f:
+        reader = csv.DictReader(f)
+        assert tuple(reader.fieldnames)[:3] == ("id", "study", "scenario")
+        assert len(list(reader)) == 16
+    with sqlite3.connect(default_out / "results.sqlite") as db:
+        assert db.execute("PRAGMA user_version").fetchone() == (1,)
+        for run_id, cost in db.execute("SELECT id, cost FROM runs WHERE solved"):
+            curve = [c for (c,) in db.execute("SELECT cost FROM cost_over_time WHERE run_id = ? "
+                                              "ORDER BY iteration", (run_id,))]
+            assert curve[-1] == cost and curve == sorted(curve, reverse=True)
+
+
+def test_same_study_twice_same_rows_and_a_rerun_or_an_extension_redoes_nothing(study_file,
+                                                                               tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert trackstar("study", str(study_file), "--out", str(a), "--workers", "1").returncode == 0
+    assert trackstar("study", str(study_file), "--out", str(b), "--workers", "2").returncode == 0
+    assert rows(a) == rows(b)
+    again = trackstar("study", str(study_file), "--out", str(a), "--json")
+    assert json.loads(again.stdout)["skipped"] == 16
+    assert "16 of 16 runs already in" in again.stderr
+    study_file.write_text(STUDY.replace("seeds: 2", "seeds: 3"))
+    more = trackstar("study", str(study_file), "--out", str(a), "--json")
+    assert json.loads(more.stdout)["skipped"] == 16 and json.loads(more.stdout)["done"] == 24
+    assert len(rows(a)) == 24
+
+
+def test_ctrl_c_keeps_finished_runs_and_the_next_invocation_goes_on(study_file, tmp_path):
+    study_file.write_text(STUDY.replace("iterations: 400", "iterations: 4000").replace(
+        "seeds: 2", "seeds: 4"))
+    out = tmp_path / "out"
+    proc = subprocess.Popen(["trackstar", "study", str(study_file), "--out", str(out), "--workers", "1"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 90
+    while time.monotonic() < deadline:
+        if (out / "results.sqlite").exists() and len(rows(out, ("id",))) >= 2:
+            break
+        time.sleep(0.2)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=15)
+    assert proc.returncode == 130, err
+    assert "run the same command again" in err
+    kept = rows(out)
+    assert 2 <= len(kept) < 32
+    done = trackstar("study", str(study_file), "--out", str(out), "--json", timeout=300)
+    summary = json.loads(done.stdout)
+    assert summary["skipped"] == len(kept) and summary["done"] == 32
+    assert set(kept) <= set(rows(out)) and len(rows(out)) == 32
+
+
+@pytest.mark.parametrize("body, words", [
+    (STUDY.replace("planners:", "planers:"), "unknown key 'planers' (did you mean 'planners'?)"),
+    (STUDY.replace("[rrt, rrtstar]", "[rrt, prm]"), "planners[1]"),
+    (STUDY.replace("eps: [1.0, 2.5]", "eps: [1.0, -1]"), "eps[1] = -1"),
+    (STUDY.replace("eps:", "epsilon:"), "unknown parameter 'epsilon' (did you mean 'eps'?)"),
+    (STUDY.replace("eps: [1.0, 2.5]", "eps: []"), "parameters.eps"),
+    (STUDY.replace("open_field", "no_such_scenario"), "scenarios[0] (no_such_scenario)"),
+    (STUDY.replace("seeds: 2", "seeds: 0"), "seeds"),
+    (STUDY.replace("  iterations: 400", "  {}"), "budget"),
+    (STUDY.replace("name: small", "name: a b"), "name"),
+    (STUDY.replace("budget:", "budget: ["), "not valid YAML"),
+    ("- just\n- a list\n", "a study is a mapping"),
+])
+def test_a_bad_study_file_exits_2_with_one_line_and_writes_nothing(study_file, tmp_path, body,
+                                                                   words):
+    study_file.write_text(body)
+    out = trackstar("study", str(study_file), "--out", str(tmp_path / "out"), timeout=30)
+    assert out.returncode == 2 and out.stdout == ""
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and words in lines[0], out.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_directory_of_another_study_is_refused(study_file, tmp_path):
+    out = tmp_path / "out"
+    study_file.write_text(STUDY.replace("seeds: 2", "seeds: 1").replace(", ./my/slalom.json", ""))
+    assert trackstar("study", str(study_file), "--out", str(out)).returncode == 0
+    study_file.write_text(STUDY.replace("name: small", "name: other"))
+    refused = trackstar("study", str(study_file), "--out", str(out))
+    assert refused.returncode == 2 and "'small'" in refused.stderr and "'other'" in refused.stderr
