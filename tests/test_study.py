@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 import signal
 import sqlite3
 import subprocess
@@ -74,6 +75,7 @@ def test_a_study_runs_its_grid_and_stores_the_numbers_plan_prints(study_file, tm
         reader = csv.DictReader(f)
         assert tuple(reader.fieldnames)[:3] == ("id", "study", "scenario")
         assert len(list(reader)) == 16
+    check_report(default_out, ["open_field", "slalom"])
     with sqlite3.connect(default_out / "results.sqlite") as db:
         assert db.execute("PRAGMA user_version").fetchone() == (1,)
         for run_id, cost in db.execute("SELECT id, cost FROM runs WHERE solved"):
@@ -82,14 +84,31 @@ def test_a_study_runs_its_grid_and_stores_the_numbers_plan_prints(study_file, tm
             assert curve[-1] == cost and curve == sorted(curve, reverse=True)
 
 
+def check_report(out, scenarios):
+    """One self-contained page: every image inline, nothing fetched; the best-setting table,
+    and per scenario the success, box plots and cost curve, also as PNGs in figures/."""
+    page = (out / "report.html").read_text()
+    sources = re.findall(r"""(?:src|href)\s*=\s*["']?([^"' >]+)""", page)
+    assert sources and all(src.startswith("data:image/png;base64,") for src in sources)
+    assert "http" not in page.replace("http-equiv", "") and "@import" not in page
+    assert "Best setting per scenario" in page
+    for scenario in scenarios:
+        assert f"<h2>{scenario}</h2>" in page
+        for name in ("success", "cost", "time_to_first_solution_s", "cost_over_time",
+                     "against_eps"):
+            assert (out / "figures" / f"{scenario}_{name}.png").stat().st_size > 1000
+    assert len(re.findall("<img", page)) == len(list((out / "figures").glob("*.png")))
+
+
 def test_same_study_twice_same_rows_and_a_rerun_or_an_extension_redoes_nothing(study_file,
                                                                                tmp_path):
     a, b = tmp_path / "a", tmp_path / "b"
     assert trackstar("study", str(study_file), "--out", str(a), "--workers", "1").returncode == 0
     assert trackstar("study", str(study_file), "--out", str(b), "--workers", "2").returncode == 0
     assert rows(a) == rows(b)
+    (a / "report.html").unlink()
     again = trackstar("study", str(study_file), "--out", str(a), "--json")
-    assert json.loads(again.stdout)["skipped"] == 16
+    assert json.loads(again.stdout)["skipped"] == 16 and (a / "report.html").is_file()
     assert "16 of 16 runs already in" in again.stderr
     study_file.write_text(STUDY.replace("seeds: 2", "seeds: 3"))
     more = trackstar("study", str(study_file), "--out", str(a), "--json")

@@ -13,6 +13,7 @@ from tqdm import tqdm
 import planner
 from app.planning import run_plan
 from app.pool import first_line, start_pool, stop_pool
+from app.study.report import write_report
 from app.study.results import Results
 from app.study.spec import Run, Study
 
@@ -71,9 +72,10 @@ def run_study(study: Study, out: Path, workers: int) -> Summary:
         results.write_csv(out / "results.csv")
     finally:
         results.close()
+    report = write_report(results.path, out)
     return Summary(study.name, str(out), len(study.runs), stored - failed, skipped, failed,
                    time.perf_counter() - started, str(results.path), str(out / "results.csv"),
-                   None)
+                   str(report))
 
 
 def _run_on_pool(study: Study, todo: list[Run], results: Results, workers: int) -> None:
