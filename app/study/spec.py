@@ -69,9 +69,11 @@ class StudyFile(StrictModel):
     kind: Literal["plan"] = "plan"
     scenarios: Annotated[list[str], Field(min_length=1)]
     planners: Annotated[list[Literal[PLANNERS]], Field(min_length=1)]
-    steering: Annotated[list[SteeringName], Field(min_length=1)] = [next(iter(STEERINGS))]
-    parameters: dict[str, Annotated[list[Any], Field(min_length=1)]] = {}
-    seeds: Annotated[list[Seed], Field(min_length=1)] = [0]
+    steering: Annotated[list[SteeringName], Field(min_length=1)] = Field(
+        default_factory=lambda: [next(iter(STEERINGS))])
+    parameters: dict[str, Annotated[list[Any], Field(min_length=1)]] = Field(
+        default_factory=dict)
+    seeds: Annotated[list[Seed], Field(min_length=1)] = Field(default_factory=lambda: [0])
     budget: Budget
 
     @field_validator("seeds", mode="before")
