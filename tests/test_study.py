@@ -147,6 +147,9 @@ def test_ctrl_c_keeps_finished_runs_and_the_next_invocation_goes_on(study_file, 
     (STUDY.replace("eps: [1.0, 2.5]", "eps: []"), "parameters.eps"),
     (STUDY.replace("open_field", "no_such_scenario"), "scenarios[0] (no_such_scenario)"),
     (STUDY.replace("seeds: 2", "seeds: 0"), "seeds"),
+    (STUDY.replace("[1.0, 2.5]", "{min: 0.5, max: 3}"), "a range needs 'sample'"),
+    (STUDY.replace("[1.0, 2.5]", "{min: 3, max: 0.5}") + "sample: 4\n", "min must be below max"),
+    (STUDY.replace("[1.0, 2.5]", "{min: -1, max: 2}") + "sample: 4\n", "eps.min = -1.0"),
     (STUDY.replace("  iterations: 400", "  {}"), "budget"),
     (STUDY.replace("name: small", "name: a b"), "name"),
     (STUDY.replace("budget:", "budget: ["), "not valid YAML"),
@@ -169,3 +172,20 @@ def test_a_directory_of_another_study_is_refused(study_file, tmp_path):
     study_file.write_text(STUDY.replace("name: small", "name: other"))
     refused = trackstar("study", str(study_file), "--out", str(out))
     assert refused.returncode == 2 and "'small'" in refused.stderr and "'other'" in refused.stderr
+
+
+def test_a_sample_draws_the_same_random_points_for_the_same_seed(study_file, tmp_path):
+    from app.study.spec import load_study
+
+    study_file.write_text(STUDY.replace("[1.0, 2.5]", "{min: 0.5, max: 4, log: true}\n"
+                                        "  goal_bias: [0.05, 0.2]")
+                          + "sample: {n: 6, seed: 3}\n")
+    first, again = load_study(study_file), load_study(study_file)
+    assert [r.key for r in first.runs] == [r.key for r in again.runs]
+    points = {r.parameters_json for r in first.runs}
+    assert len(points) == 6  # rrt and rrtstar share the points (neither sweeps γ here)
+    eps = [json.loads(p)["eps"] for p in points]
+    assert all(0.5 <= e <= 4 for e in eps) and len(set(eps)) == 6
+    assert len(first.runs) == 2 * 2 * 6 * 2  # scenarios × planners × points × seeds
+    study_file.write_text(study_file.read_text().replace("seed: 3", "seed: 4"))
+    assert {r.parameters_json for r in load_study(study_file).runs} != points

@@ -53,7 +53,8 @@ def _label(row: dict) -> str:
     params = json.loads(row["parameters"])
     budget = " ".join(f"{k}={v:g}" for k, v in (("K", row["budget_iterations"]),
                                                 ("T", row["budget_time_s"])) if v is not None)
-    words = [row["planner"], row["steering"], *(f"{k}={v}" for k, v in params.items()), budget]
+    values = (f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
+    words = [row["planner"], row["steering"], *values, budget]
     return " ".join(words)
 
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
+import numpy as np
 import yaml
 from pydantic import Field, ValidationError, field_validator, model_validator
 
@@ -61,6 +62,34 @@ class Budget(StrictModel):
         return list(itertools.product(self.iterations or [None], self.time_s or [None]))
 
 
+class Range(StrictModel):
+    """A parameter's range for a random sample: uniform, or log-uniform with ``log``."""
+
+    min: float
+    max: float
+    log: bool = False
+
+    @model_validator(mode="after")
+    def _ordered(self) -> Range:
+        if not self.min < self.max:
+            raise ValueError(f"min must be below max, got {self.min} and {self.max}")
+        if self.log and self.min <= 0:
+            raise ValueError(f"a log range needs min > 0, got {self.min}")
+        return self
+
+    def draw(self, rng: np.random.Generator) -> float:
+        if self.log:
+            return float(np.exp(rng.uniform(np.log(self.min), np.log(self.max))))
+        return float(rng.uniform(self.min, self.max))
+
+
+class Sample(StrictModel):
+    """Random parameter points instead of the full grid: ``n`` draws from seed ``seed``."""
+
+    n: Count
+    seed: Seed = 0
+
+
 class StudyFile(StrictModel):
     """The keys of a study file (docs/studies.md)."""
 
@@ -71,8 +100,9 @@ class StudyFile(StrictModel):
     planners: Annotated[list[Literal[PLANNERS]], Field(min_length=1)]
     steering: Annotated[list[SteeringName], Field(min_length=1)] = Field(
         default_factory=lambda: [next(iter(STEERINGS))])
-    parameters: dict[str, Annotated[list[Any], Field(min_length=1)]] = Field(
+    parameters: dict[str, Annotated[list[Any], Field(min_length=1)] | Range] = Field(
         default_factory=dict)
+    sample: Sample | None = None
     seeds: Annotated[list[Seed], Field(min_length=1)] = Field(default_factory=lambda: [0])
     budget: Budget
 
@@ -86,21 +116,63 @@ class StudyFile(StrictModel):
             return list(range(seeds))
         return seeds
 
+    @field_validator("sample", mode="before")
+    @classmethod
+    def _sample_count(cls, sample: Any) -> Any:
+        """``sample: N`` means N points from seed 0."""
+        return {"n": sample} if isinstance(sample, int) and not isinstance(sample, bool) \
+            else sample
+
+    @field_validator("parameters", mode="before")
+    @classmethod
+    def _ranges(cls, parameters: Any) -> Any:
+        """A mapping as a value is a range: validated here, so its error names it."""
+        if not isinstance(parameters, dict):
+            return parameters
+        out = {}
+        for key, values in parameters.items():
+            try:
+                out[key] = Range.model_validate(values) if isinstance(values, dict) else values
+            except ValidationError as exc:
+                raise ValueError(f"{key}: {describe(exc)}") from None
+        return out
+
     @field_validator("parameters")
     @classmethod
     def _values(cls, parameters: dict) -> dict:
-        """Known names, and each value as `PlanOptions` validates it, so the study and
-        `trackstar plan` agree."""
+        """Known names, and each value (a range's ends) as `PlanOptions` validates it, so the
+        study and `trackstar plan` agree."""
         for key, values in parameters.items():
             if key not in PARAMETERS:
                 raise ValueError(f"unknown parameter '{key}'{suggest(key, PARAMETERS)}")
-            for i, value in enumerate(values):
+            named = ([(f"{key}.min", values.min), (f"{key}.max", values.max)]
+                     if isinstance(values, Range) else
+                     [(f"{key}[{i}]", v) for i, v in enumerate(values)])
+            for where, value in named:
                 try:
                     PlanOptions(**{key: value})
                 except ValidationError as exc:
                     msg = exc.errors()[0]["msg"]
-                    raise ValueError(f"{key}[{i}] = {value!r}: {msg}") from None
+                    raise ValueError(f"{where} = {value!r}: {msg}") from None
         return parameters
+
+    @model_validator(mode="after")
+    def _ranges_need_a_sample(self) -> StudyFile:
+        for key, values in self.parameters.items():
+            if isinstance(values, Range) and self.sample is None:
+                raise ValueError(f"parameters.{key}: a range needs 'sample' (random points); "
+                                 f"give a list of values for the grid")
+        return self
+
+    def points(self) -> list[dict]:
+        """The parameter points: the grid's, or ``sample.n`` random ones."""
+        keys = list(self.parameters)
+        if self.sample is None:
+            return [dict(zip(keys, values, strict=True))
+                    for values in itertools.product(*self.parameters.values())]
+        rng = np.random.default_rng(self.sample.seed)
+        return [{k: v.draw(rng) if isinstance(v, Range) else v[int(rng.integers(len(v)))]
+                 for k, v in self.parameters.items()} for _ in range(self.sample.n)]
 
 
 @dataclass(frozen=True)
@@ -139,10 +211,10 @@ class Study:
     runs: list[Run]
 
 
-def _points(parameters: dict, planner_name: str) -> list[dict]:
-    keys = [k for k in parameters if planner_name == "rrtstar" or k not in _RRTSTAR_ONLY]
-    return [dict(zip(keys, values, strict=True))
-            for values in itertools.product(*(parameters[k] for k in keys))]
+def _has(planner_name: str, point: dict) -> dict:
+    """The part of a parameter point that ``planner_name`` has."""
+    return {k: v for k, v in point.items()
+            if planner_name == "rrtstar" or k not in _RRTSTAR_ONLY}
 
 
 def _scenario(source: str, study: Path, where: str) -> planner.Scenario:
@@ -177,10 +249,11 @@ def load_study(path: str | Path) -> Study:
         scenario = _scenario(source, path, f"scenarios[{i}]")
         scenarios.setdefault(scenario.name, scenario)
     seeds = list(range(spec.seeds)) if isinstance(spec.seeds, int) else spec.seeds
+    points = spec.points()
     runs, seen = [], set()
     for name, planner_name, steering in itertools.product(scenarios, spec.planners,
                                                           spec.steering):
-        for point in _points(spec.parameters, planner_name):
+        for point in (_has(planner_name, p) for p in points):
             for (iterations, time_s), seed in itertools.product(spec.budget.points(), seeds):
                 run = Run(name, planner_name, steering, point, iterations, time_s, seed)
                 if run.key not in seen:
