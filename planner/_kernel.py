@@ -40,7 +40,8 @@ from planner._world import World, motion_free, static_clearance_estimate
 
 # Parameter vector indices.
 (EPS, GAMMA, GOAL_BIAS, RHO, SPEED, GX, GY, GTH, GPOS, GHEAD, INFORMED, STAR, STEERING,
- SX, SY, K_RRT, DIMS, NPARAMS) = range(18)
+ SX, SY, K_RRT, DIMS, METRIC, NPARAMS) = range(19)
+STEERING_METRIC, SE2_METRIC = range(2)  # planner.options.METRICS
 LANE_SHARE, LANE_SIGMA = 0.9, 0.25  # track scenarios: headings sampled along the lane
 NEAREST_BUCKETS = 256  # nearest's queue: half-cell buckets, the last one takes the rest
 # Counter indices.
@@ -241,9 +242,39 @@ def _heap_pop(keys, vals, size) -> int:
     return size
 
 
+@njit(cache=True, inline="always")
+def _se2(a, b, rho) -> float:
+    """√(Δx² + Δy² + (ρ·Δθ)²): the cheap metric of many car planners."""
+    dth = rho * wrap_angle(b[2] - a[2])
+    return math.sqrt((b[0] - a[0]) ** 2 + (b[1] - a[1]) ** 2 + dth * dth)
+
+
+@njit(cache=True, inline="always")
+def _metric_bound(metric, code, a, b, rho) -> float:
+    """A lower bound of the nearest-neighbour metric (the chord, for se2)."""
+    if metric == SE2_METRIC:
+        return math.hypot(b[0] - a[0], b[1] - a[1])
+    return steer_bound(code, a, b, rho)
+
+
+@njit(cache=True, inline="always")
+def _metric_tight_bound(metric, code, a, b, rho) -> float:
+    if metric == SE2_METRIC:
+        return 0.0
+    return steer_tight_bound(code, a, b, rho)
+
+
+@njit(cache=True, inline="always")
+def _metric(metric, code, a, b, rho, bound) -> float:
+    if metric == SE2_METRIC:
+        return _se2(a, b, rho)
+    return steer_length(code, a, b, rho, bound)
+
+
 @njit(cache=True)
 def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
-    """(node, steering length) of the tree node with the shortest car path to the query pose.
+    """(node, distance) of the tree node nearest to the query pose by the metric: the
+    shortest car path (steering length) or se2.
 
     Best first: grid rings are opened outward and their nodes filed by a lower bound of their
     path length into buckets half a cell wide; exact lengths are computed bucket by bucket,
@@ -254,7 +285,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
     tighter `steer_tight_bound` and is filed again (key −1 − bound) if that moves it up: poses
     facing back at the tree pass the turning circles' bound by the hundred on a small track.
     """
-    code, rho = int(P[STEERING]), P[RHO]
+    code, rho, metric = int(P[STEERING]), P[RHO], int(P[METRIC])
     to = state(qx, qy, qth, math.cos(qth), math.sin(qth), rho)
     nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
     ci, cj = _cell(tree, qx, qy)
@@ -277,7 +308,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             if lb >= 0.0:  # filed by its cheap bound: refine it first
                 if lb >= best:
                     continue
-                lb = max(lb, steer_tight_bound(code, _node(tree, node), to, rho))
+                lb = max(lb, _metric_tight_bound(metric, code, _node(tree, node), to, rho))
                 b = min(int(lb / width), NEAREST_BUCKETS - 1)
                 if lb < best and b > cur:  # no longer among the lowest: file it again
                     key[node] = -1.0 - lb
@@ -288,7 +319,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             else:
                 lb = -1.0 - lb  # refined before
             if lb < best:
-                d = steer_length(code, _node(tree, node), to, rho, best)
+                d = _metric(metric, code, _node(tree, node), to, rho, best)
                 if d < best:
                     best, besti = d, node
         elif ring_bound >= best:
@@ -297,7 +328,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             for q in range(_ring_cells(tree, ci, cj, k, cells)):
                 node = tree.cell_head[cells[q]]
                 while node >= 0:
-                    lb = steer_bound(code, _node(tree, node), to, rho)
+                    lb = _metric_bound(metric, code, _node(tree, node), to, rho)
                     if lb < best:
                         b = min(int(lb / width), NEAREST_BUCKETS - 1)
                         key[node] = lb
@@ -542,7 +573,9 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
         near_i, dist = nearest(tree, P, xr, yr, thr)
         nx0, ny0, nth0 = tree.pose[near_i, 0], tree.pose[near_i, 1], tree.pose[near_i, 2]
         thr = arrival_heading(code, nx0, ny0, nth0, xr, yr, thr)
-        steer_path(code, nx0, ny0, nth0, xr, yr, thr, P[RHO], kinds, lens)
+        length = steer_path(code, nx0, ny0, nth0, xr, yr, thr, P[RHO], kinds, lens)
+        if P[METRIC] == SE2_METRIC:
+            dist = length  # the metric chose the node; the edge is driven by the steering
         if dist > P[EPS]:
             truncate(kinds, lens, P[EPS], cut)
             lens[:] = cut

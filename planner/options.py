@@ -15,9 +15,10 @@ from pydantic import BaseModel, ConfigDict, Field
 from planner.scenario import ScenarioError
 from planner.steering import STEERINGS, SteeringName
 
-__all__ = ["PLANNERS", "PlanOptions", "PositiveFinite", "Seed"]
+__all__ = ["METRICS", "PLANNERS", "PlanOptions", "PositiveFinite", "Seed"]
 
 PLANNERS = ("rrt", "rrtstar")
+METRICS = ("steering", "se2")  # the kernel's codes are their positions
 DEFAULT_TIME_S = 1.0
 
 PositiveFinite = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -50,6 +51,10 @@ class PlanOptions(BaseModel):
                           "(OMPL: 5.5).")
     goal_bias: Annotated[float, Field(ge=0, lt=1)] = Field(
         0.05, description="Probability of sampling the goal.")
+    metric: Literal[METRICS] = Field(
+        "steering", description="Nearest-neighbour metric: steering, the exact steering "
+                                "length; se2, the cheap sqrt(dx² + dy² + (ρ·dθ)²) many car "
+                                "planners start with.")
     informed: bool | None = Field(
         None, description="Informed sampling after the first solution [default: on for RRT*].")
     speed: PositiveFinite | None = Field(

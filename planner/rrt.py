@@ -19,7 +19,7 @@ from planner._paths import pose_at, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
 from planner._world import path_clearances
-from planner.options import PLANNERS, PlanOptions
+from planner.options import METRICS, PLANNERS, PlanOptions
 from planner.problem import Problem
 from planner.steering import STEERINGS
 from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points
@@ -96,6 +96,7 @@ class Planner:
         P[K.SX], P[K.SY] = problem.start[:2]
         P[K.K_RRT] = s.k_rrt or 0.0
         P[K.DIMS] = s.dimensions
+        P[K.METRIC] = METRICS.index(s.metric)
         self._P = P
         zero = np.zeros(5)
         K.add_node(self._tree, P, *problem.start, 0.0, -1, zero.astype(np.int8), zero)

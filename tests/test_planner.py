@@ -195,3 +195,28 @@ def test_the_cost_curve_is_the_same_for_a_seed_whatever_the_batches():
         many.step(n)
     curve = [(c, i) for _, c, i in one.result().cost_over_time]
     assert curve == [(c, i) for _, c, i in many.result().cost_over_time] and len(curve) > 3
+
+
+def test_the_se2_metric_picks_the_se2_nearest_and_still_plans_exact_paths():
+    """`metric="se2"`: the nearest node by √(Δx² + Δy² + (ρΔθ)²), as a scan of every node
+    finds it; the edges are still the exact steering paths, so the paths check out."""
+    from planner import Planner, PlanOptions
+    from planner import _kernel as K
+
+    problem = planner.compile_problem(planner.parse_scenario(scenario_dict("slalom")))
+    run = Planner(problem, PlanOptions(metric="se2", seed=3))
+    run.step(2000)
+    tree, rho = run.snapshot(), problem.rho
+    rng = np.random.default_rng(1)
+    xmin, ymin, xmax, ymax = problem.bounds
+    for _ in range(100):
+        q = (rng.uniform(xmin, xmax), rng.uniform(ymin, ymax), rng.uniform(-math.pi, math.pi))
+        node, found = K.nearest(run._tree, run._P, *q)
+        d = np.sqrt(((tree.pose[:, :2] - q[:2]) ** 2).sum(axis=1)
+                    + (rho * np.remainder(q[2] - tree.pose[:, 2] + math.pi, 2 * math.pi)
+                       - rho * math.pi) ** 2)
+        assert found == pytest.approx(d.min(), abs=1e-9) and d[node] == pytest.approx(found)
+    result = plan("slalom", iterations=4000, metric="se2")
+    assert result.solved and first_collision(scenario_dict("slalom"), result.path[:, :3]) is None
+    assert arc_mismatch(result.path[:, :3]) < 1e-6
+    assert result.cost != plan("slalom", iterations=4000).cost  # another tree

@@ -60,7 +60,8 @@ def _label(row: dict) -> str:
 
 def _order(row: dict) -> tuple:
     params = sorted(json.loads(row["parameters"]).items())
-    return (row["planner"], row["steering"], [(k, float(v)) for k, v in params],
+    values = [(k, (0, v, "") if isinstance(v, int | float) else (1, 0, str(v))) for k, v in params]
+    return (row["planner"], row["steering"], values,
             row["budget_iterations"] or -1, row["budget_time_s"] or -1.0, row["seed"])
 
 
@@ -127,7 +128,7 @@ def _figures(db, scenario: str, settings: dict[str, Setting]):
         ax.plot(grid, mid, color=f"C{i % 10}", label=label)
         ax.fill_between(grid, low, high, color=f"C{i % 10}", alpha=0.15)
     ax.set_xlabel("time (s)" if by_time else "iterations")
-    ax.set_ylabel("best cost (m): median and quartiles over seeds")
+    ax.set_ylabel("best cost (m): median, quartiles\nover the seeds solved so far")
     ax.legend(fontsize="small")
     yield "cost_over_time", "Cost over " + ("time" if by_time else "iterations"), fig
 

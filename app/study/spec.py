@@ -26,7 +26,7 @@ from planner.validation import StrictModel, describe, suggest
 __all__ = ["PARAMETERS", "Run", "Study", "StudyError", "load_study"]
 
 # The axes a study may sweep: `trackstar plan`'s options, under the same names.
-PARAMETERS = ("eps", "gamma", "k_rrt", "goal_bias", "informed", "speed")
+PARAMETERS = ("eps", "gamma", "k_rrt", "goal_bias", "informed", "metric", "speed")
 _RRTSTAR_ONLY = ("gamma", "k_rrt", "informed")
 
 Count = Annotated[int, Field(ge=1)]
