@@ -14,14 +14,15 @@ import shapely
 import planner
 from planner.problem import follow_waypoints
 
-__all__ = ["Z", "add_grid", "car_outline", "curvature_colors", "draw_obstacles", "draw_poses",
-           "draw_track", "fit_camera", "motion_table", "move_obstacles", "obstacle_rings",
-           "obstacle_shape",
-           "offset_at", "polyline_segments", "wxyz_yaw", "yaw_wxyz"]
+__all__ = ["Z", "add_grid", "car_outline", "curvature_colors", "draw_car",
+           "draw_obstacles", "draw_poses", "draw_track", "fit_camera", "marker_size",
+           "motion_table", "move_obstacles", "obstacle_rings", "obstacle_shape", "offset_at",
+           "polyline_segments", "wxyz_yaw", "yaw_wxyz"]
 
 # Obstacles above the tree: edges pass where a moving obstacle is at other times.
 Z = {"surface": -0.02, "centre": 0.002, "tree": 0.006, "flash": 0.008, "obstacle": 0.009,
-     "path": 0.01, "step": 0.012, "pose": 0.014}
+     "path": 0.01, "step": 0.012, "pose": 0.014, "car": 0.016}
+CAR_RGB, CAR_LINE_RGB = (250, 250, 250), (20, 20, 20)
 
 
 def polyline_segments(pts: np.ndarray, z: float, closed: bool = False) -> np.ndarray:
@@ -165,6 +166,45 @@ def car_outline(length: float, width: float) -> np.ndarray:
     """An arrow-nosed car footprint in its own frame (rear axle at the origin, heading +x)."""
     return np.array([[-0.3, -0.5], [0.7, -0.5], [1.0, 0.0], [0.7, 0.5], [-0.3, 0.5]]) * [
         length, width]
+
+
+def _car_ring(vehicle, marker: float) -> np.ndarray:
+    """The car's outline about its rear axle, heading +x: see `draw_car`."""
+    fp = vehicle.footprint
+    if fp is None:
+        a = np.linspace(0, 2 * math.pi, 32, endpoint=False)
+        r = vehicle.radius or 2 * marker
+        return np.column_stack([r * np.cos(a), r * np.sin(a)])
+    back = -(fp.rear_overhang if fp.rear_overhang is not None
+             else max(fp.length - vehicle.wheelbase, 0.0) / 2)
+    w = fp.width / 2
+    return np.array([[back, -w], [back + fp.length, -w], [back + fp.length, w], [back, w]])
+
+
+def draw_car(scene, name: str, vehicle, marker: float, pose):
+    """The car as the planner plans it, in a frame ``name`` at ``pose`` (x, y, heading) that
+    the caller moves: its footprint rectangle (the rear axle ``rear_overhang`` in front of the
+    rear bumper), else the disc of ``vehicle.radius``. A point car (radius 0) gets a disc of two
+    ``marker`` (the start's and goal's size) only so that it stays visible. White with a dark
+    outline and a line from the rear axle to the front, so the heading shows on a disc too; the
+    Drive car and the simulated car are this one drawing."""
+    ring = _car_ring(vehicle, marker)
+    frame = scene.add_frame(name, show_axes=False, position=(*pose[:2], 0.0),
+                            wxyz=yaw_wxyz(pose[2]))
+    _fill(scene, f"{name}/body", [ring], Z["car"], CAR_RGB)
+    nose = np.array([[0.0, 0.0], [ring[:, 0].max(), 0.0]])
+    scene.add_line_segments(
+        f"{name}/outline", np.concatenate([polyline_segments(ring, Z["car"], True),
+                                           polyline_segments(nose, Z["car"])]),
+        CAR_LINE_RGB, thickness=2.5, thickness_units="screen")
+    return frame
+
+
+def marker_size(bounds) -> float:
+    """The size of the scene's markers (start, goal, step overlay): 0.6 % of the larger side of
+    ``bounds``, so they look the same on a 30 cm track and a 100 m one."""
+    xmin, ymin, xmax, ymax = bounds
+    return 0.006 * max(xmax - xmin, ymax - ymin)
 
 
 def draw_poses(scene, scenario: planner.Scenario, size: float) -> dict:

@@ -26,14 +26,13 @@ from app.studio._panel import PLANNERS, SPEEDS, STEERINGS, build_panel
 from app.studio._plots import Profiles
 from app.studio._scenario import default_scenario, goal_fraction
 from app.studio._scene import (
-    Z,
-    _fill,
     add_grid,
-    car_outline,
+    draw_car,
     draw_obstacles,
     draw_poses,
     draw_track,
     fit_camera,
+    marker_size,
     move_obstacles,
     yaw_wxyz,
 )
@@ -150,19 +149,14 @@ class Session:
                 self._show_car(path, t)
 
     def _show_car(self, path: np.ndarray, t: float) -> None:
-        """The car where the best path is at time t (its column 5), at the vehicle's size: its
-        footprint rectangle, or 1.4 × 0.7 wheelbases when it plans as a disc."""
+        """The car (`draw_car`) where the best path is at time t (its column 5)."""
         k = int(np.searchsorted(path[:, 5], t).clip(0, len(path) - 1))
-        x, y, th = path[k, :3]
+        x, y, th = (float(v) for v in path[k, :3])
         if self._car is None:
-            v = self.parsed.vehicle
-            length, width = ((v.footprint.length, v.footprint.width) if v.footprint else
-                             (1.4 * v.wheelbase, 0.7 * v.wheelbase))
-            self._car = self.scene.add_frame("/live/car", show_axes=False)
-            _fill(self.scene, "/live/car/body", [car_outline(length, width)], Z["pose"],
-                 (20, 20, 20))
-        self._car.position = (float(x), float(y), 0.0)
-        self._car.wxyz = yaw_wxyz(float(th))
+            self._car = draw_car(self.scene, "/live/car", self.parsed.vehicle, self.marker(),
+                                 (x, y, th))
+        self._car.position = (x, y, 0.0)
+        self._car.wxyz = yaw_wxyz(th)
 
     def drive(self) -> None:
         """`Drive car`: the scene clock restarts at 0 and plays; the car and the moving
@@ -178,8 +172,7 @@ class Session:
         self.show_time(0.0)
 
     def marker(self) -> float:
-        xmin, ymin, xmax, ymax = self.problem.bounds if self.problem else (0, 0, 10, 10)
-        return 0.006 * max(xmax - xmin, ymax - ymin)
+        return marker_size(self.problem.bounds)
 
     def scenario_json(self) -> str:
         """The scenario as planned (a custom track embedded), named by the `Name` field."""

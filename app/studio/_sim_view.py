@@ -21,7 +21,15 @@ import numpy as np
 
 import planner
 from app.studio._live_view import PATH_RGB, TREE_RGB
-from app.studio._scene import Z, _fill, obstacle_shape, polyline_segments, yaw_wxyz
+from app.studio._scene import (
+    Z,
+    _fill,
+    draw_car,
+    marker_size,
+    obstacle_shape,
+    polyline_segments,
+    yaw_wxyz,
+)
 from planner.sim import SimSettings
 from planner.sim.control import CONTROLLERS
 from planner.sim.run import Frame, simulate
@@ -36,8 +44,8 @@ WINDOW_S = 20.0  # s of history in the plots
 PLOT_POINTS = 400
 PREDICT_S = 2.0  # s of predicted motion drawn ahead of each believed obstacle
 EDGE_PIECES = 4  # straight pieces per drawn tree edge
-GHOST_RGB, CAR_RGB = (90, 200, 255), (250, 250, 250)
-SIM_Z = {"ghost": Z["obstacle"] + 0.001, "car": Z["pose"] + 0.002}
+GHOST_RGB = (90, 200, 255)
+GHOST_Z = Z["obstacle"] + 0.001
 
 
 @dataclass
@@ -150,19 +158,6 @@ def _tree_segments(tree: planner.TreeSnapshot) -> np.ndarray:
     return seg.reshape(-1, 2, 3)
 
 
-def _car_ring(vehicle) -> np.ndarray:
-    """The car's outline about its rear axle, heading +x: its footprint rectangle or disc."""
-    fp = vehicle.footprint
-    if fp is None:
-        a = np.linspace(0, 2 * math.pi, 32, endpoint=False)
-        r = max(vehicle.radius, 0.05)  # a point car still shows
-        return np.column_stack([r * np.cos(a), r * np.sin(a)])
-    back = -(fp.rear_overhang if fp.rear_overhang is not None
-             else max(fp.length - vehicle.wheelbase, 0.0) / 2)
-    w = fp.width / 2
-    return np.array([[back, -w], [back + fp.length, -w], [back + fp.length, w], [back, w]])
-
-
 class SimView:
     """The `Simulate` folder and the drawing of its runs in one session's scene."""
 
@@ -213,17 +208,10 @@ class SimView:
     # -- drawing -------------------------------------------------------------------------------
     def _draw_static(self) -> None:
         """Meshes drawn once per run and then only moved: the car and the movers' ghosts."""
-        scene, scn = self.s.scene, self.s.problem.scenario
-        ring = _car_ring(scn.vehicle)
-        car = scene.add_frame("/sim/car", show_axes=False, position=(*scn.start[:2], 0.0),
-                              wxyz=yaw_wxyz(scn.start[2]))
-        self._handles["car"] = car
-        _fill(scene, "/sim/car/body", [ring], SIM_Z["car"], CAR_RGB)
-        nose = np.array([[0.0, 0.0], [ring[:, 0].max(), 0.0]])
-        scene.add_line_segments(
-            "/sim/car/outline", np.concatenate([polyline_segments(ring, SIM_Z["car"], True),
-                                                polyline_segments(nose, SIM_Z["car"])]),
-            (20, 20, 20), thickness=2.5, thickness_units="screen")
+        scene, problem = self.s.scene, self.s.problem
+        scn = problem.scenario
+        self._handles["car"] = draw_car(scene, "/sim/car", scn.vehicle,
+                                        marker_size(problem.bounds), scn.start)
         self._movers = mover_index(scn)
         self._centres.clear()
         for i, ob in enumerate(scn.obstacles):
@@ -233,7 +221,7 @@ class SimView:
             self._centres[i] = np.array([x, y])
             self._handles[f"ghost{i}"] = scene.add_frame(
                 f"/sim/ghost{i}", show_axes=False, position=(x, y, 0.0), wxyz=yaw_wxyz(yaw))
-            _fill(scene, f"/sim/ghost{i}/shape", [local], SIM_Z["ghost"], GHOST_RGB,
+            _fill(scene, f"/sim/ghost{i}/shape", [local], GHOST_Z, GHOST_RGB,
                   opacity=0.35)
 
     def _put(self, name: str, seg: np.ndarray, rgb, px: float) -> None:
@@ -284,7 +272,7 @@ class SimView:
             lines.append([c + sensed, c + now + vel * PREDICT_S])
         seg = np.zeros((len(lines), 2, 3), np.float32)
         if lines:
-            seg[:, :, :2], seg[:, :, 2] = lines, SIM_Z["ghost"]
+            seg[:, :, :2], seg[:, :, 2] = lines, GHOST_Z
         self._put("prediction", seg, GHOST_RGB, 2.0)
         now = time.monotonic()
         if (f.reference is not None and f.reference is not self._shown["reference"]
