@@ -49,7 +49,7 @@ def wire(s) -> None:
     u.scenario_upload.on_upload(lambda _: _scenario_uploaded(s))
     u.scenario_save.on_click(lambda _: _save_to_server(s))
     u.scenario_load.on_click(lambda _: _load_from_server(s))
-    for control in (u.planner, u.steering, u.eps, u.gamma, u.k_rrt, u.goal_bias, u.budget,
+    for control in (u.planner_name, u.steering, u.eps, u.gamma, u.k_rrt, u.goal_bias, u.budget,
                     u.seed, u.speed_v):
         control.on_update(lambda _: s.reset())
     u.rate.on_update(lambda _: setattr(s.worker, "rate", SPEEDS[u.rate.value]))

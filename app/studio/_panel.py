@@ -48,7 +48,7 @@ class Panel:
     scenario_save: object
     scenario_load: object
     scenario_name: object
-    planner: object
+    planner_name: object
     steering: object
     eps: object
     gamma: object
@@ -105,7 +105,7 @@ def build_panel(gui) -> Panel:
         scenario_save = gui.add_button("Save to server")
         scenario_load = gui.add_button("Load from server")
     with gui.add_folder("Planner"):
-        planner = gui.add_dropdown("Planner", tuple(PLANNERS), initial_value="RRT*")
+        planner_name = gui.add_dropdown("Planner", tuple(PLANNERS), initial_value="RRT*")
         steering = gui.add_dropdown("Steering", tuple(STEERINGS))
         eps = gui.add_number("ε (m, 0 = auto)", 0.0, min=0.0, step=0.05)
         gamma = gui.add_number("γ (0 = auto)", 0.0, min=0.0, step=0.5)

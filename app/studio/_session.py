@@ -184,7 +184,7 @@ class Session:
         """The planner panel as `PlanOptions`: 0 in a number field means "derived"."""
         u = self.ui
         return planner.PlanOptions(
-            planner=PLANNERS[u.planner.value], steering=STEERINGS[u.steering.value],
+            planner=PLANNERS[u.planner_name.value], steering=STEERINGS[u.steering.value],
             eps=u.eps.value or None, gamma=u.gamma.value or None, k_rrt=u.k_rrt.value or None,
             goal_bias=float(u.goal_bias.value), seed=int(u.seed.value),
             speed=u.speed_v.value or None)
