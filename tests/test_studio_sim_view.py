@@ -1,17 +1,16 @@
 """The studio's simulation view without a browser: a real viser server (no client connected),
-a stand-in session, the crossing scenario; what `SimView.tick` draws is the frame it drew."""
+its scene clock, the crossing scenario; what `SimView.tick` draws is the frame it drew."""
 
 from __future__ import annotations
 
-import threading
 import time
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 import viser
 
 import planner
+from app.studio._clock import SceneClock
 from app.studio._scene import yaw_wxyz
 from app.studio._sim_view import EDGE_PIECES, SimView
 
@@ -19,20 +18,16 @@ from app.studio._sim_view import EDGE_PIECES, SimView
 @pytest.fixture
 def view():
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
-    problem = planner.compile_problem(planner.load_scenario("crossing"))
-    session = SimpleNamespace(
-        client=SimpleNamespace(gui=server.gui), scene=server.scene, problem=problem,
-        ui=SimpleNamespace(scene_time=server.gui.add_slider("Scene time (s)", 0.0, 30.0, 0.1,
-                                                            0.0)),
-        _lock=threading.RLock(), reset=lambda: None, notify=lambda *a: None)
-    sim = SimView(session)
+    clock = SceneClock(server.gui.add_slider("Scene time (s)", 0.0, 30.0, 0.1, 0.0),
+                       server.gui.add_checkbox("Play scene time", False), max_step=0.16)
+    sim = SimView(server.gui, server.scene, clock)
     yield sim
     sim.clear()
     server.stop()
 
 
 def test_the_view_draws_the_frame_it_received(view):
-    view.start()
+    view.start(planner.compile_problem(planner.load_scenario("crossing")), view.settings())
     run = view.run
     deadline = time.monotonic() + 60
     while (run.frame is None or run.frame.t < 1.5 or run.tree_version == 0) and (
@@ -44,7 +39,7 @@ def test_the_view_draws_the_frame_it_received(view):
     car = view._handles["car"]
     assert np.allclose(car.position, (*f.pose[:2], 0.0))
     assert np.allclose(car.wxyz, yaw_wxyz(f.pose[2]))
-    assert view.s.ui.scene_time.value == pytest.approx(f.t)  # the true mover, at the clock
+    assert view.clock.t == pytest.approx(f.t)  # the true mover, at the clock
     # The ghost: the last sensing, extrapolated at constant velocity to the frame's time.
     s = f.sensing
     believed = np.array([10.0, -1.3]) + s.offsets[0] + s.velocities[0] * (f.t - s.t)

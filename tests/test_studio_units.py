@@ -10,9 +10,8 @@ import numpy as np
 import pytest
 
 import planner
-from app.studio._actions import parse_waypoints
 from app.studio._custom import Draft, custom_scenario
-from app.studio._edit import moved_obstacle
+from app.studio._edit import moved_obstacle, parse_waypoints
 from app.studio._extend import LINES, StepInfo, explain, render
 from app.studio._scenario import default_scenario
 from app.studio._tree import EdgeChunks

@@ -1,105 +1,188 @@
-"""Editing in the scene: gizmos that drag and turn obstacles, the start and the goal on the
-ground plane; polygons and tracks drawn by clicking the ground; a drawn track's Bézier handles.
+"""Editing the scenario in the scene: obstacles added from the panel or clicked as polygons,
+gizmos that drag and turn obstacles, the start and the goal, and the motion of the selected
+obstacle.
 
-Gizmo callbacks are ``async`` so viser runs them in order on its event loop. A drag only moves
-the drawn frame (one position update); the release commits the new pose to the scenario on a
-thread, because compiling it and restarting the planner takes longer than a frame.
+`Editor` owns the gizmos, the selection, the polygon being clicked and what a ground click does;
+it never changes the scenario itself: it hands a new scenario dict to ``apply`` (the session's,
+which compiles it and restarts the planner) and draws drags through the stage's previews.
 """
 
 from __future__ import annotations
 
 import math
-import threading
+import re
 
 import numpy as np
 
-from app.studio._scene import (
-    Z,
-    obstacle_shape,
-    offset_at,
-    polyline_segments,
-    wxyz_yaw,
-    yaw_wxyz,
-)
+from app.studio._gizmo import gizmo
+from app.studio._scene import DRAFT_RGB, Z, obstacle_shape, polyline_segments
 
-__all__ = ["click_mode", "draft_changed", "moved_obstacle", "nearest_s", "place_gizmos",
-           "show_gizmos", "show_polygon"]
-
-GIZMO_PX = 70  # gizmos keep their size on screen, whatever the track's scale
-DRAFT_RGB = (255, 120, 0)
-TURN_ONLY_Z = ((0.0, 0.0), (0.0, 0.0), (-1000.0, 1000.0))
+__all__ = ["Editor", "moved_obstacle", "nearest_s", "parse_waypoints"]
 
 
-def _gizmo(s, name: str, pose, on_move, on_commit, rotate: bool = True, px: int = GIZMO_PX,
-           visible: bool | None = None):
-    """A ground-plane gizmo at pose (x, y, yaw): translate in x/y, turn about z only.
-    ``on_move(x, y, yaw)`` runs on every change, ``on_commit(x, y, yaw)`` at release; shown
-    with the `Drag handles` box unless ``visible`` says otherwise."""
-    h = s.scene.add_transform_controls(
-        name, scale=px, fixed=True, active_axes=(True, True, False), disable_rotations=not rotate,
-        rotation_limits=TURN_ONLY_Z, depth_test=False, position=(pose[0], pose[1], Z["pose"]),
-        wxyz=yaw_wxyz(pose[2]),
-        visible=bool(s.ui.handles.value) if visible is None else visible)
+class Editor:
+    def __init__(self, scene, ui, stage, apply, track_click, notify) -> None:
+        """``apply(scenario) -> bool`` shows a changed scenario; ``track_click((x, y))`` takes
+        ground clicks while `Draw (click the ground)` is ticked."""
+        self.scene, self.ui, self.stage = scene, ui, stage
+        self._apply, self._track_click, self.notify = apply, track_click, notify
+        self._selected: int | None = None  # the obstacle `Set motion of selected` changes
+        self._gizmos: list = []
+        self._polygon: list[tuple[float, float]] = []  # corners of a polygon being clicked
+        self._click_mode: str | None = None
 
-    @h.on_update
-    async def _(ev) -> None:
-        x, y, _ = ev.target.position
-        yaw = wxyz_yaw(ev.target.wxyz)
-        on_move(x, y, yaw)
-        if ev.phase == "end" and on_commit is not None:
-            threading.Thread(target=on_commit, args=(x, y, yaw), daemon=True).start()
+    # -- gizmos: obstacles, start, goal ---------------------------------------------------------
+    def place_gizmos(self) -> None:
+        """Gizmos for every obstacle, the start and the goal of the stage's scenario."""
+        for h in self._gizmos:
+            h.remove()
+        self._gizmos = []
+        parsed, visible = self.stage.parsed, bool(self.ui.handles.value)
+        for i, ob in enumerate(parsed.obstacles):
+            pose, _ = obstacle_shape(ob)
+            self._gizmos.append(gizmo(
+                self.scene, f"/edit/o{i}", pose,
+                lambda x, y, yaw, i=i: self.stage.preview_obstacle(i, x, y, yaw),
+                lambda x, y, yaw, i=i: self._commit_obstacle(i, x, y, yaw),
+                rotate=ob.type != "circle", visible=visible))
+        for key in ("start", "goal"):
+            self._gizmos.append(gizmo(
+                self.scene, f"/edit/{key}", getattr(parsed, key),
+                lambda x, y, yaw, key=key: self.stage.preview_pose(key, x, y, yaw),
+                lambda x, y, yaw, key=key: self._apply(dict(
+                    self.stage.scenario,
+                    **{key: _round([x, y, math.remainder(yaw, 2 * math.pi)])})),
+                visible=visible))
 
-    return h
+    def forget_gizmos(self) -> None:
+        """The scene was cleared, and the gizmos with it."""
+        self._gizmos = []
+
+    def show_gizmos(self) -> None:
+        for h in self._gizmos:
+            h.visible = bool(self.ui.handles.value)
+
+    def _commit_obstacle(self, i: int, x: float, y: float, yaw: float) -> None:
+        stage = self.stage
+        obstacles = list(stage.scenario["obstacles"])
+        obstacles[i] = moved_obstacle(obstacles[i], stage.parsed.obstacles[i], x, y, yaw,
+                                      stage.track)
+        self._selected = i
+        self._apply(dict(stage.scenario, obstacles=obstacles))
+
+    # -- obstacles from the panel ---------------------------------------------------------------
+    def add_obstacle(self, kind: str) -> None:
+        """A new circle or box on the centreline, between start and goal, away from the
+        others."""
+        track = self.stage.track
+        prof = track.sample(track.detail_spacing())
+        n = len(self.stage.scenario["obstacles"])
+        frac = (0.2 + 0.15 * (n % 4)) * (0.75 if track.closed else 0.9)
+        i = int(np.searchsorted(prof.s, frac * track.length_m))
+        x, y, heading = float(prof.x[i]), float(prof.y[i]), float(prof.heading[i])
+        size = 0.3 * track.width_m
+        if kind == "circle":
+            ob = {"type": "circle", "center": [x, y], "radius": round(size, 5)}
+        else:
+            ob = {"type": "box", "center": [x, y], "size": [round(2 * size, 5), round(size, 5)],
+                  "angle_deg": round(math.degrees(heading), 1)}
+        self._add(ob)
+
+    def close_polygon(self) -> None:
+        """The clicked corners become a polygon obstacle."""
+        if len(self._polygon) < 3:
+            self.notify("No polygon",
+                        "tick 'Polygon (click the ground)' and click 3 or more corners")
+            return
+        ob = {"type": "polygon", "points": [[round(x, 5), round(y, 5)] for x, y in self._polygon]}
+        self._polygon = []
+        self._show_polygon()
+        self.ui.polygon.value = False
+        self._add(ob)
+
+    def clear_obstacles(self) -> None:
+        self._apply(dict(self.stage.scenario, obstacles=[]))
+
+    def _add(self, ob: dict) -> None:
+        """Add ``ob`` with the motion chosen in the panel; it becomes the selected obstacle."""
+        try:
+            motion = self._motion(ob)
+        except ValueError as exc:
+            self.notify("Obstacle not added", str(exc))
+            return
+        if motion is not None:
+            ob = dict(ob, motion=motion)
+        scenario = self.stage.scenario
+        if self._apply(dict(scenario, obstacles=[*scenario["obstacles"], ob])):
+            self._selected = len(self.stage.scenario["obstacles"]) - 1
+
+    def set_motion(self) -> None:
+        """The panel's motion for the selected obstacle (the last one added or dragged)."""
+        obstacles = list(self.stage.scenario["obstacles"])
+        if self._selected is None or self._selected >= len(obstacles):
+            self.notify("No obstacle selected", "add an obstacle or drag one first")
+            return
+        try:
+            motion = self._motion(obstacles[self._selected])
+        except ValueError as exc:
+            self.notify("Motion not set", str(exc))
+            return
+        ob = {k: v for k, v in obstacles[self._selected].items() if k != "motion"}
+        obstacles[self._selected] = ob if motion is None else dict(ob, motion=motion)
+        self._apply(dict(self.stage.scenario, obstacles=obstacles))
+
+    def _motion(self, ob: dict) -> dict | None:
+        """The `Motion` control as a scenario motion (planner/scenario.py Motion) for ``ob``."""
+        u = self.ui
+        kind = u.motion.value
+        if kind == "velocity":
+            return {"velocity": [float(v) for v in u.velocity.value]}
+        if kind == "waypoints":
+            return {"waypoints": parse_waypoints(u.waypoints.value)}
+        if kind == "follow track":
+            x, y = np.mean(np.reshape(ob.get("center", ob.get("points")), (-1, 2)), axis=0)
+            return {"follow_track": {"speed": float(u.track_speed.value),
+                                     "start_s": round(nearest_s(self.stage.track, x, y), 4)}}
+        return None
+
+    # -- clicks on the ground -------------------------------------------------------------------
+    def click_mode(self, mode: str) -> None:
+        """Ground clicks add track points or polygon corners; ticking one mode unticks the
+        other."""
+        u = self.ui
+        this, other = (u.draw, u.polygon) if mode == "track" else (u.polygon, u.draw)
+        if this.value and other.value:
+            other.value = False  # runs this again, which settles the mode
+            return
+        self._click_mode = "track" if u.draw.value else "polygon" if u.polygon.value else None
+        self.scene.remove_click_callback("all")
+        if self._click_mode is not None:
+            self.scene.on_click()(self._ground_click)
+
+    def _ground_click(self, ev) -> None:
+        """Where the click ray meets the ground plane z = 0."""
+        (ox, oy, oz), (dx, dy, dz) = ev.ray_origin, ev.ray_direction
+        if abs(dz) < 1e-12 or -oz / dz < 0:
+            return
+        t = -oz / dz
+        p = (ox + t * dx, oy + t * dy)
+        if self._click_mode == "polygon":
+            self._polygon.append(p)
+            self._show_polygon()
+        elif self._click_mode == "track":
+            self._track_click(p)
+
+    def _show_polygon(self) -> None:
+        pts = np.array(self._polygon, dtype=float).reshape(-1, 2)
+        seg = (polyline_segments(pts, Z["pose"], closed=len(pts) > 2) if len(pts) > 1
+               else np.zeros((0, 2, 3)))
+        self.scene.add_line_segments("/polygon_draft", seg, DRAFT_RGB, thickness=2.0,
+                                     thickness_units="screen", visible=len(seg) > 0)
+        self.ui.polygon.label = f"Polygon (click the ground) — {len(pts)} corners"
 
 
 def _round(v) -> list[float]:
     return [round(float(c), 5) for c in v]
-
-
-# -- obstacles, start, goal -------------------------------------------------------------------
-def place_gizmos(s) -> None:
-    """Gizmos for every obstacle, the start and the goal of the current scenario."""
-    for h in s.gizmos:
-        h.remove()
-    s.gizmos = []
-    parsed = s.parsed
-    for i, ob in enumerate(parsed.obstacles):
-        pose, _ = obstacle_shape(ob)
-        s.gizmos.append(_gizmo(
-            s, f"/edit/o{i}", pose, lambda x, y, yaw, i=i: _move_obstacle(s, i, x, y, yaw),
-            lambda x, y, yaw, i=i: _commit_obstacle(s, i, x, y, yaw),
-            rotate=ob.type != "circle"))
-    for key in ("start", "goal"):
-        pose = getattr(parsed, key)
-        s.gizmos.append(_gizmo(
-            s, f"/edit/{key}", pose,
-            lambda x, y, yaw, key=key: _move_frame(s.pose_frames[key], x, y, yaw),
-            lambda x, y, yaw, key=key: s.apply_scenario(
-                dict(s.scenario, **{key: _round([x, y, math.remainder(yaw, 2 * math.pi)])}))))
-
-
-def show_gizmos(s) -> None:
-    for h in s.gizmos:
-        h.visible = bool(s.ui.handles.value)
-
-
-def _move_frame(frame, x: float, y: float, yaw: float) -> None:
-    frame.position = (x, y, 0.0)
-    frame.wxyz = yaw_wxyz(yaw)
-
-
-def _move_obstacle(s, i: int, x: float, y: float, yaw: float) -> None:
-    """The drawn obstacle follows the gizmo (plus its motion's offset at the scene time)."""
-    frame, _, table = s.drawn[i]
-    dx, dy = offset_at(table, s.ui.scene_time.value)
-    _move_frame(frame, x + dx, y + dy, yaw)
-
-
-def _commit_obstacle(s, i: int, x: float, y: float, yaw: float) -> None:
-    obstacles = list(s.scenario["obstacles"])
-    obstacles[i] = moved_obstacle(obstacles[i], s.parsed.obstacles[i], x, y, yaw, s.track)
-    s.selected = i
-    s.apply_scenario(dict(s.scenario, obstacles=obstacles))
 
 
 def moved_obstacle(ob: dict, parsed, x: float, y: float, yaw: float, track) -> dict:
@@ -126,98 +209,14 @@ def nearest_s(track, x: float, y: float) -> float:
     return float(prof.s[np.argmin(np.hypot(prof.x - x, prof.y - y))])
 
 
-# -- clicks on the ground ---------------------------------------------------------------------
-def click_mode(s, mode: str) -> None:
-    """Ground clicks add track points or polygon corners; ticking one mode unticks the other."""
-    this, other = (s.ui.draw, s.ui.polygon) if mode == "track" else (s.ui.polygon, s.ui.draw)
-    if this.value and other.value:
-        other.value = False  # runs this again, which settles the mode
-        return
-    s.click_mode = "track" if s.ui.draw.value else "polygon" if s.ui.polygon.value else None
-    s.scene.remove_click_callback("all")
-    if s.click_mode is not None:
-        s.scene.on_click()(lambda ev: _ground_click(s, ev))
-
-
-def _ground_click(s, ev) -> None:
-    """Where the click ray meets the ground plane z = 0."""
-    (ox, oy, oz), (dx, dy, dz) = ev.ray_origin, ev.ray_direction
-    if abs(dz) < 1e-12 or -oz / dz < 0:
-        return
-    t = -oz / dz
-    p = (ox + t * dx, oy + t * dy)
-    if s.click_mode == "polygon":
-        s.polygon.append(p)
-        show_polygon(s)
-    elif s.click_mode == "track":
-        s.draft.add(p)
-        draft_changed(s)
-
-
-def show_polygon(s) -> None:
-    pts = np.array(s.polygon, dtype=float).reshape(-1, 2)
-    seg = polyline_segments(pts, Z["pose"], closed=len(pts) > 2) if len(pts) > 1 else np.zeros(
-        (0, 2, 3))
-    s.scene.add_line_segments("/polygon_draft", seg, DRAFT_RGB, thickness=2.0,
-                              thickness_units="screen", visible=len(seg) > 0)
-    s.ui.polygon.label = f"Polygon (click the ground) — {len(pts)} corners"
-
-
-# -- the drawn track --------------------------------------------------------------------------
-def _bezier_points(ctrl: np.ndarray, n: int = 24) -> np.ndarray:
-    t = np.linspace(0.0, 1.0, n)[:, None]
-    return ((1 - t) ** 3 * ctrl[0] + 3 * (1 - t) ** 2 * t * ctrl[1]
-            + 3 * (1 - t) * t ** 2 * ctrl[2] + t ** 3 * ctrl[3])
-
-
-def _draw_draft_lines(s) -> None:
-    """The curve through the anchors and each anchor's handle bar (mirrored both ways)."""
-    d, closed = s.draft, bool(s.ui.draw_close.value)
-    curves = [polyline_segments(_bezier_points(c), Z["pose"]) for c in d.beziers(closed)]
-    bars = [polyline_segments(np.array([p - h, p + h]), Z["pose"])
-            for p, h in ((d.points[i], d.handle(i, closed)) for i in range(len(d.points)))]
-    empty = np.zeros((0, 2, 3), np.float32)
-    s.scene.add_line_segments("/draft/line", np.concatenate(curves) if curves else empty,
-                              DRAFT_RGB, thickness=2.0, thickness_units="screen",
-                              visible=bool(curves))
-    s.scene.add_line_segments("/draft/bars", np.concatenate(bars) if bars else empty,
-                              (255, 200, 120), thickness=1.0, thickness_units="screen",
-                              visible=bool(bars))
-
-
-def _move_anchor(s, i: int, x: float, y: float) -> None:
-    s.draft.points[i] = np.array([x, y])
-    _place_handle_tips(s)
-    _draw_draft_lines(s)
-
-
-def _move_handle(s, i: int, x: float, y: float) -> None:
-    s.draft.handles[i] = np.array([x, y]) - s.draft.points[i]
-    _draw_draft_lines(s)
-
-
-def _place_handle_tips(s) -> None:
-    """Automatic handles follow their neighbours: keep their gizmos on the tips."""
-    closed = bool(s.ui.draw_close.value)
-    for i, (_, tip) in enumerate(s.draft_gizmos):
-        if s.draft.handles[i] is None:
-            tip.position = (*(s.draft.points[i] + s.draft.handle(i, closed)), Z["pose"])
-
-
-def draft_changed(s) -> None:
-    """Redraw the drawn track with a gizmo per anchor (drags the point) and per handle tip
-    (drags the tangent, which stops following Catmull-Rom)."""
-    for anchor, tip in s.draft_gizmos:
-        anchor.remove()
-        tip.remove()
-    s.draft_gizmos = []
-    closed = bool(s.ui.draw_close.value)
-    for i, p in enumerate(s.draft.points):
-        tip = p + s.draft.handle(i, closed)
-        s.draft_gizmos.append((
-            _gizmo(s, f"/draft/a{i}", (*p, 0.0), lambda x, y, _, i=i: _move_anchor(s, i, x, y),
-                   None, rotate=False, px=60, visible=True),
-            _gizmo(s, f"/draft/h{i}", (*tip, 0.0), lambda x, y, _, i=i: _move_handle(s, i, x, y),
-                   None, rotate=False, px=35, visible=True)))
-    _draw_draft_lines(s)
-    s.ui.draw.label = f"Draw (click the ground) — {len(s.draft.points)} points"
+def parse_waypoints(text: str) -> list[list[float]]:
+    """'0 0 0; 3 0.5 0' → [[0, 0, 0], [3, 0.5, 0]]: rows t (s), dx, dy (m) from where the
+    obstacle is drawn."""
+    rows = [r for r in re.split(r"[;\n]", text) if r.strip()]
+    try:
+        out = [[float(v) for v in re.split(r"[\s,]+", r.strip())] for r in rows]
+    except ValueError:
+        out = []
+    if not out or any(len(r) != 3 for r in out):
+        raise ValueError(f"waypoints are rows 't dx dy' separated by ';', got {text!r}")
+    return out

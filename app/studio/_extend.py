@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import planner
 
-__all__ = ["LINES", "StepInfo", "explain", "render"]
+__all__ = ["FIRST_NOTE", "LINES", "StepInfo", "explain", "render"]
 
 LINES = (
     "x_rand ← SampleFree()",
@@ -24,6 +24,7 @@ LINES = (
     "    for x ∈ X_near cheaper through x_new: Rewire(x → x_new)",
     "return T",
 )
+FIRST_NOTE = "Press Step to run one iteration."  # the panel's note before the first step
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import planner
 import tracks
-from app.studio._extend import render
+from app.studio._extend import FIRST_NOTE, render
 
 __all__ = ["MOTIONS", "PLANNERS", "SPEEDS", "STEERINGS", "Panel", "build_panel"]
 
@@ -125,6 +125,6 @@ def build_panel(gui) -> Panel:
     with gui.add_folder("Metrics"):
         metrics = gui.add_markdown("—")
     with gui.add_folder("EXTEND"):
-        extend = gui.add_html(render(None, "Press Step to run one iteration."))
+        extend = gui.add_html(render(None, FIRST_NOTE))
     plots = gui.add_folder("Profiles")
     return Panel(**{k: v for k, v in locals().items() if k != "gui"})

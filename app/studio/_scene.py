@@ -14,7 +14,7 @@ import shapely
 import planner
 from planner.problem import follow_waypoints
 
-__all__ = ["Z", "add_grid", "car_outline", "curvature_colors", "draw_car",
+__all__ = ["DRAFT_RGB", "Z", "add_grid", "car_outline", "curvature_colors", "draw_car",
            "draw_obstacles", "draw_poses", "draw_track", "fit_camera", "marker_size",
            "motion_table", "move_obstacles", "obstacle_rings", "obstacle_shape", "offset_at",
            "polyline_segments", "wxyz_yaw", "yaw_wxyz"]
@@ -23,6 +23,7 @@ __all__ = ["Z", "add_grid", "car_outline", "curvature_colors", "draw_car",
 Z = {"surface": -0.02, "centre": 0.002, "tree": 0.006, "flash": 0.008, "obstacle": 0.009,
      "path": 0.01, "step": 0.012, "pose": 0.014, "car": 0.016}
 CAR_RGB, CAR_LINE_RGB = (250, 250, 250), (20, 20, 20)
+DRAFT_RGB = (255, 120, 0)  # what is being clicked: polygon corners, a drawn track
 
 
 def polyline_segments(pts: np.ndarray, z: float, closed: bool = False) -> np.ndarray:

@@ -4,7 +4,7 @@ A run goes on its own thread (`simulate(..., realtime=True)`); its observer keep
 `Frame`, the plot history and, at most every ``TREE_S``, the current tree's edges — read there,
 since a planner's arrays are only safe to read on the thread that runs it. The session's ticker
 calls `SimView.tick`, which draws the latest state: the car; the movers where they truly are
-(the session's own obstacles, its scene clock set to the simulation's time); where the car
+(the stage's own obstacles, the scene clock set to the simulation's time); where the car
 believes they are (translucent ghosts: the last sensing extrapolated at constant velocity, with
 a line to where it predicts them ``PREDICT_S`` later); the committed path, the tree, Soll/Ist
 steering and lateral error plots and the metrics.
@@ -159,38 +159,32 @@ def _tree_segments(tree: planner.TreeSnapshot) -> np.ndarray:
 
 
 class SimView:
-    """The `Simulate` folder and the drawing of its runs in one session's scene."""
+    """The `Simulate` folder and the drawing of its runs in one tab's scene, their only writer;
+    it shows the simulated time on the scene ``clock`` (`SceneClock`)."""
 
-    def __init__(self, session) -> None:
-        self.s = session
-        self.ui = build_controls(session.client.gui)
+    def __init__(self, gui, scene, clock) -> None:
+        self.scene, self.clock = scene, clock
+        self.ui = build_controls(gui)
         self.run: _Run | None = None
         self._handles: dict[str, object] = {}
         self._movers = np.zeros(0, np.int64)  # per scenario obstacle: its motion (-1: static)
         self._centres: dict[int, np.ndarray] = {}  # per mover: its declared centre (m)
         self._shown = {"frame": None, "reference": None, "path_at": 0.0, "tree": 0, "slow": 0.0}
-        self.ui.simulate.on_click(lambda _: self.start())
-        self.ui.stop.on_click(lambda _: self.stop())
 
     # -- commands ------------------------------------------------------------------------------
-    def start(self) -> None:
-        """A new run of the session's scenario; the planner's own run is reset out of the way."""
+    def settings(self) -> SimSettings:
+        """The folder's settings (ValueError when they are not valid)."""
         u = self.ui
-        try:
-            settings = SimSettings(rate=float(u.rate.value), controller=u.controller.value,
-                                   noise=float(u.noise.value), seed=int(u.seed.value),
-                                   realtime=True)
-        except ValueError as exc:
-            self.s.notify("Simulation settings", str(exc))
-            return
-        with self.s._lock:
-            self.clear()
-            self.s.reset()
-            self._draw_static()
-            clock = self.s.ui.scene_time
-            clock.max = max(clock.max, settings.duration)
-            self.run = _Run(self.s.problem, settings)
-        u.status.content = "Simulation: **starting**"
+        return SimSettings(rate=float(u.rate.value), controller=u.controller.value,
+                           noise=float(u.noise.value), seed=int(u.seed.value), realtime=True)
+
+    def start(self, problem, settings: SimSettings) -> None:
+        """A new run of ``problem`` (the caller keeps the planner's own run out of its way)."""
+        self.clear()
+        self._draw_static(problem)
+        self.clock.reach(settings.duration)
+        self.run = _Run(problem, settings)
+        self.ui.status.content = "Simulation: **starting**"
 
     def stop(self) -> None:
         if self.run is not None:
@@ -206,10 +200,9 @@ class SimView:
         self._shown.update(frame=None, reference=None, tree=0)
 
     # -- drawing -------------------------------------------------------------------------------
-    def _draw_static(self) -> None:
+    def _draw_static(self, problem) -> None:
         """Meshes drawn once per run and then only moved: the car and the movers' ghosts."""
-        scene, problem = self.s.scene, self.s.problem
-        scn = problem.scenario
+        scene, scn = self.scene, problem.scenario
         self._handles["car"] = draw_car(scene, "/sim/car", scn.vehicle,
                                         marker_size(problem.bounds), scn.start)
         self._movers = mover_index(scn)
@@ -228,7 +221,7 @@ class SimView:
         h = self._handles.get(name)
         if h is None:
             if len(seg):
-                self._handles[name] = self.s.scene.add_line_segments(
+                self._handles[name] = self.scene.add_line_segments(
                     f"/sim/{name}", seg, rgb, thickness=px, thickness_units="screen")
         elif len(seg):
             h.points, h.visible = seg, True
@@ -260,7 +253,7 @@ class SimView:
         x, y, th = f.pose
         car = self._handles["car"]
         car.position, car.wxyz = (x, y, 0.0), yaw_wxyz(th)
-        self.s.ui.scene_time.value = f.t  # the session draws the true movers at its clock
+        self.clock.set(f.t)  # the stage draws the true movers at the scene clock
         lines = []
         for i, c in self._centres.items():
             m, sensing = self._movers[i], f.sensing

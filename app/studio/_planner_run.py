@@ -1,0 +1,173 @@
+"""The planner's run in one tab and everything that shows it: the worker, its live drawing, the
+profile plots, the `Status`, `Metrics` and `EXTEND` panels, and the car that drives the best
+path (`Drive car`).
+
+`PlannerRun` is the only writer of those; it plans the stage's current problem, and any change
+of scenario or planner setting starts a fresh run (`reset`): the old tree belongs to the old one.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+import planner
+import tracks
+from app.studio._extend import FIRST_NOTE, explain, render
+from app.studio._live_view import LiveView
+from app.studio._panel import PLANNERS, SPEEDS, STEERINGS
+from app.studio._plots import Profiles
+from app.studio._scenario import goal_fraction
+from app.studio._scene import draw_car, marker_size, yaw_wxyz
+from app.studio._worker import PlannerWorker
+
+__all__ = ["PlannerRun"]
+
+PLOT_S = 1.0  # profile plots redraw at most this often (uPlot re-renders all of it)
+
+
+class PlannerRun:
+    def __init__(self, gui, scene, ui, stage, clock, notify) -> None:
+        self.gui, self.scene, self.ui = gui, scene, ui
+        self.stage, self.clock, self.notify = stage, clock, notify
+        self.worker: PlannerWorker | None = None
+        self._driving = False  # the car shows the best path at the scene time
+        self._view: LiveView | None = None
+        self._profiles: Profiles | None = None
+        self._car = None
+        self._shown: dict = {}  # versions of the worker's record already shown
+
+    def new_track(self, track: tracks.Track, vehicle) -> None:
+        """The stage cleared the scene (the run's drawing went with it): profile plots of the
+        new track's centreline, for a vehicle of this size."""
+        self._view, self._car = None, None
+        if self._profiles is not None:
+            for h in (self._profiles.curvature, self._profiles.steering, self._profiles.cost):
+                h.remove()
+        prof = track.sample(track.detail_spacing(), vehicle.wheelbase, vehicle.max_steer_deg)
+        with self.ui.plots:
+            self._profiles = Profiles(self.gui, prof.s, prof.curvature,
+                                      goal_fraction(track.closed) * track.length_m,
+                                      vehicle.wheelbase, vehicle.max_steer_deg)
+
+    def options(self) -> planner.PlanOptions:
+        """The planner panel as `PlanOptions`: 0 in a number field means "derived"."""
+        u = self.ui
+        return planner.PlanOptions(
+            planner=PLANNERS[u.planner_name.value], steering=STEERINGS[u.steering.value],
+            eps=u.eps.value or None, gamma=u.gamma.value or None, k_rrt=u.k_rrt.value or None,
+            goal_bias=float(u.goal_bias.value), seed=int(u.seed.value),
+            speed=u.speed_v.value or None)
+
+    def reset(self) -> None:
+        """A fresh run of the stage's problem with the current settings (the old worker is
+        stopped first)."""
+        problem = self.stage.problem
+        self.stop()
+        if self._view is not None:
+            self._view.clear()
+        try:
+            options = self.options()
+            options.resolved(problem)  # refuses a robot this steering cannot drive
+        except ValueError as exc:
+            self.notify("Planner options", str(exc))
+            options = planner.PlanOptions()
+        self.worker = PlannerWorker(problem, options, int(self.ui.budget.value),
+                                    SPEEDS[self.ui.rate.value])
+        self._view = LiveView(self.scene, self.worker.live, marker_size(problem.bounds))
+        self._shown = {"metrics": -1, "best": 0, "step": 0}
+        self._driving = False
+        if self._car is not None:
+            self._car.remove()
+            self._car = None
+        self.ui.metrics.content = "—"
+        self.ui.extend.content = render(None, FIRST_NOTE)
+        if self._profiles is not None:
+            self._profiles.show_path(np.zeros((0, 4)))
+
+    def stop(self) -> None:
+        if self.worker is not None:
+            self.worker.stop()
+
+    def set_rate(self) -> None:
+        self.worker.rate = SPEEDS[self.ui.rate.value]
+
+    # -- the car -------------------------------------------------------------------------------
+    def drive(self) -> None:
+        """`Drive car`: the scene clock restarts at 0 and plays; the car and the moving
+        obstacles share it, so what the planner avoided in time is what you see avoided."""
+        path = self.worker.live.best_path
+        if path is None or not len(path):
+            self.notify("No path yet", "press Run until a path to the goal is found")
+            return
+        self._driving = True
+        self.clock.reach(path[-1, 5])
+        self.show_car(0.0)  # the clock may be at 0 already: then setting it draws nothing
+        self.clock.play_from_start()
+
+    @property
+    def drive_end(self) -> float | None:
+        """When the driving car reaches the goal (the scene clock loops there); None when no
+        car drives."""
+        path = self.worker.live.best_path if self._driving else None
+        return float(path[-1, 5]) if path is not None and len(path) else None
+
+    def show_car(self, t: float) -> None:
+        """The driving car where the best path is at time t (its column 5)."""
+        path = self.worker.live.best_path if self.worker is not None else None
+        if not self._driving or path is None or not len(path):
+            return
+        k = int(np.searchsorted(path[:, 5], t).clip(0, len(path) - 1))
+        x, y, th = (float(v) for v in path[k, :3])
+        if self._car is None:
+            problem = self.stage.problem
+            self._car = draw_car(self.scene, "/live/car", problem.scenario.vehicle,
+                                 marker_size(problem.bounds), (x, y, th))
+        self._car.position = (x, y, 0.0)
+        self._car.wxyz = yaw_wxyz(th)
+
+    # -- the ticker ----------------------------------------------------------------------------
+    def tick(self) -> None:
+        """Draw the worker's progress and update the panels with what changed."""
+        if self._view is None:
+            return
+        live = self.worker.live
+        self._view.tick()
+        status = f"Status: **{live.state}**" + (f" — {live.error}" if live.error else "")
+        if status != self.ui.status.content:  # GUI updates re-render the panel: only changes
+            self.ui.status.content = status
+        if live.metrics_version != self._shown["metrics"]:
+            self._shown["metrics"] = live.metrics_version
+            self.ui.metrics.content = _metrics_md(live.metrics)
+        slow_tick = time.monotonic() - self._shown.get("plotted", 0.0) > PLOT_S
+        if live.best_version != self._shown["best"] and live.best_path is not None and slow_tick:
+            self._shown["best"], self._shown["plotted"] = live.best_version, time.monotonic()
+            self._profiles.show_path(live.best_path)
+            self._profiles.show_cost(list(live.cost_over_time))
+        if live.step_version != self._shown["step"] and live.step is not None:
+            self._shown["step"] = live.step_version
+            line, note = explain(live.step["info"], live.step["star"])
+            self.ui.extend.content = render(line, f"Iteration {live.step['info'].iteration}: "
+                                                  + note)
+
+
+def _fmt(v, unit: str = "", digits: int = 3) -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "—"
+    return f"{v:.{digits}g}{unit}" if isinstance(v, float) else f"{v}{unit}"
+
+
+def _metrics_md(m: dict) -> str:
+    if not m:
+        return "—"
+    return "\n".join([
+        f"| iterations | {m['iterations']} |", "|---|---|",
+        f"| nodes | {m['nodes']} |",
+        f"| rewires | {m['rewires']} |",
+        f"| time to first solution | {_fmt(m['time_to_first_solution_s'], ' s')} |",
+        f"| cost | {_fmt(m['cost'], ' m', 4)} |",
+        f"| min clearance | {_fmt(m['min_clearance_m'], ' m')} |",
+        f"| iterations/s | {_fmt(m['iterations_per_s'], '', 4)} |",
+    ])

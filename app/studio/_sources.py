@@ -1,0 +1,126 @@
+"""Tracks and scenarios into and out of a tab: the library, an uploaded SVG, scenario JSON files
+and the server's scenario store.
+
+`Sources` holds only the uploaded SVG while one of its paths is chosen; what it loads goes to
+``set_track`` (the session's, which puts it on the stage and resets the rest).
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+
+import httpx
+import numpy as np
+
+import planner
+import tracks
+from app.studio._custom import custom_scenario
+from app.studio._scenario import default_scenario
+from planner.problem import resolve_track
+
+__all__ = ["Sources"]
+
+
+class Sources:
+    def __init__(self, client, ui, stage, api_url: str, set_track, notify) -> None:
+        """``api_url`` is the REST API's base URL (it ends in /api/v1)."""
+        self.client, self.ui, self.stage, self.api_url = client, ui, stage, api_url
+        self._set_track, self.notify = set_track, notify
+        self._svg: str | None = None  # the uploaded file
+
+    # -- tracks ---------------------------------------------------------------------------------
+    def show_library(self, name: str) -> None:
+        self._set_track(tracks.load_library_track(name), default_scenario(name))
+
+    def svg_uploaded(self) -> None:
+        """Offer the file's paths; the first one is shown."""
+        data = self.ui.svg_upload.value.content
+        try:
+            paths = [p["id"] for p in tracks.inspect_svg(data)["paths"]]
+        except (tracks.TrackError, ValueError, KeyError) as exc:
+            self.notify("SVG not loaded", str(exc))
+            return
+        if not paths:
+            self.notify("SVG not loaded", "the file has no path")
+            return
+        self._svg = data
+        self.ui.svg_path.options = tuple(paths)
+        self.ui.svg_path.visible = len(paths) > 1
+        if self.ui.svg_path.value == paths[0]:
+            self.svg_path_chosen()
+        else:
+            self.ui.svg_path.value = paths[0]  # fires svg_path_chosen
+
+    def svg_path_chosen(self) -> None:
+        if self._svg is None or self.ui.svg_path.value not in self.ui.svg_path.options:
+            return
+        try:
+            track = tracks.load_svg(self._svg, path_id=self.ui.svg_path.value)
+        except (tracks.TrackError, ValueError) as exc:
+            self.notify("SVG not loaded", str(exc))
+            return
+        self.use_track(track)
+
+    def use_track(self, track: tracks.Track) -> None:
+        """A track of no scenario (uploaded, drawn) with a start, a goal and no obstacles."""
+        try:
+            self._set_track(track, custom_scenario(track, track.name or "custom"))
+        except (planner.ScenarioError, ValueError, tracks.TrackError) as exc:
+            self.notify("Track not usable", str(exc))
+
+    # -- scenarios ------------------------------------------------------------------------------
+    def load_scenario(self, data: dict) -> None:
+        """A scenario with a track (library or embedded) shows it; any other is drawn by its
+        bounds."""
+        scenario = planner.parse_scenario(data)  # raises ScenarioError with a one-line message
+        if scenario.track is not None:
+            self._set_track(resolve_track(scenario), data)
+            return
+        xmin, ymin, xmax, ymax = scenario.bounds
+        box = [[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax], [xmin, ymin]]
+        track = tracks.Track(name=scenario.name, closed=False, width_m=1e-3, segments=tuple(
+            tracks.line(np.array(a), np.array(b)) for a, b in itertools.pairwise(box)))
+        self._set_track(track, data)
+
+    def scenario_uploaded(self) -> None:
+        try:
+            self.load_scenario(json.loads(self.ui.scenario_upload.value.content))
+        except (ValueError, UnicodeDecodeError) as exc:
+            self.notify("Scenario not loaded", str(exc))
+
+    def download_scenario(self) -> None:
+        name = self._name()
+        self.client.send_file_download(f"{name}.json", self.stage.scenario_json(name).encode(),
+                                       save_immediately=True)
+
+    def save_to_server(self) -> None:
+        """POST to the server's scenario store."""
+        try:
+            r = httpx.post(f"{self.api_url}/scenarios",
+                           json=json.loads(self.stage.scenario_json(self._name())), timeout=10.0)
+            r.raise_for_status()
+            self.client.add_notification("Saved", f"scenario '{r.json()['name']}' stored as "
+                                         f"{r.json()['id']}", auto_close_seconds=4.0)
+        except (httpx.HTTPError, KeyError, ValueError) as exc:
+            self.notify("Not saved", f"the server's scenario store: {exc}")
+
+    def load_from_server(self) -> None:
+        """The newest scenario whose id or name is the Name field: a bundled one (slalom,
+        crossing, …) or one saved to the server."""
+        name = self.ui.scenario_name.value
+        try:
+            r = httpx.get(f"{self.api_url}/scenarios", timeout=10.0)
+            r.raise_for_status()
+            records = r.json()
+            found = [rec for rec in records if name in (rec["id"], rec["name"])]
+            if not found:
+                bundled = ", ".join(rec["id"] for rec in records if rec["source"] == "library")
+                raise ValueError(f"no scenario with id or name '{name}' (bundled: {bundled})")
+            self.load_scenario(found[-1]["scenario"])
+        except (httpx.HTTPError, KeyError, ValueError) as exc:
+            self.notify("Not loaded", f"scenario '{name}' from the server: {exc}")
+
+    def _name(self) -> str:
+        """The `Name` field, which names saved and downloaded scenarios."""
+        return self.ui.scenario_name.value or "studio"
