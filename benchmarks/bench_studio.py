@@ -26,7 +26,6 @@ import websockets.sync.client
 
 import planner
 from app.studio import launch
-from app.studio._actions import load_scenario
 from app.studio._worker import PlannerWorker
 from planner.rrt import warm_up
 
@@ -115,12 +114,12 @@ def main() -> None:
         time.sleep(0.05)
     session = next(iter(studio.sessions.values()))
     time.sleep(1.0)
-    load_scenario(session, data)
+    session.sources.load_scenario(data)
     session.ui.seed.value = 1  # resets the run with the same settings as the baseline
     session.ui.budget.value = 10**9
-    session.reset()
+    session.planning.reset()
     time.sleep(0.5)
-    with_ui = _time_to(session.worker, n, marks)
+    with_ui = _time_to(session.planning.worker, n, marks)
     time.sleep(0.3)
     wire.close()
     studio.stop()
