@@ -1,8 +1,8 @@
 """Tracks and scenarios into and out of a tab: the library, an uploaded SVG, scenario JSON files
 and the server's scenario store.
 
-`Sources` holds only the uploaded SVG while one of its paths is chosen; what it loads goes to
-``set_track`` (the session's, which puts it on the stage and resets the rest).
+`Sources` holds only the uploaded SVG, kept so that another of its paths can be chosen; what it
+loads goes to ``set_track`` (the session's, which puts it on the stage and resets the rest).
 """
 
 from __future__ import annotations
