@@ -189,3 +189,53 @@ def test_a_sample_draws_the_same_random_points_for_the_same_seed(study_file, tmp
     assert len(first.runs) == 2 * 2 * 6 * 2  # scenarios × planners × points × seeds
     study_file.write_text(study_file.read_text().replace("seed: 3", "seed: 4"))
     assert {r.parameters_json for r in load_study(study_file).runs} != points
+
+
+SIM_STUDY = """\
+name: rates
+kind: simulate
+scenarios: [crossing]
+parameters:
+  rate: [4, 30]
+  fixed_latency_ms: [20]
+  duration: [25]
+seeds: [1]
+"""
+
+
+def test_a_driven_study_stores_what_simulate_prints(tmp_path):
+    study = tmp_path / "rates.yaml"
+    study.write_text(SIM_STUDY)
+    out = trackstar("study", str(study), "--out", str(tmp_path / "out"), "--json")
+    assert out.returncode == 0, out.stderr
+    assert json.loads(out.stdout)["done"] == 2
+    columns = ("parameters", "reached", "collisions", "min_clearance_m", "time_to_goal_s",
+               "cycle_p99_ms", "replans", "emergency_stops", "max_lateral_error_m")
+    with sqlite3.connect(tmp_path / "out" / "results.sqlite") as db:
+        stored = db.execute(f"SELECT {', '.join(columns)} FROM sim_runs").fetchall()
+    assert len(stored) == 2
+    for params, *numbers in stored:
+        rate = json.loads(params)["rate"]
+        s = json.loads(trackstar("simulate", "crossing", "--rate", str(rate), "--fixed-latency",
+                                 "20", "--duration", "25", "--seed", "1", "--json").stdout)
+        assert numbers == [int(s["reached_goal"]), s["collisions"], s["min_clearance_m"],
+                           s["time_to_goal_s"], s["cycle_ms"]["p99"], s["replans"],
+                           s["emergency_stops"], s["cross_track_error_m"]["max"]]
+    page = (tmp_path / "out" / "report.html").read_text()
+    assert "goal reached" in page and "Against rate" in page
+    assert (tmp_path / "out" / "figures" / "crossing_collisions.png").is_file()
+
+
+@pytest.mark.parametrize("edit, words", [
+    (lambda s: s + "planners: [rrt]\n", "planners: a simulate study replans"),
+    (lambda s: s.replace("rate: [4, 30]", "rates: [4, 30]"), "unknown parameter 'rates'"),
+    (lambda s: s.replace("rate: [4, 30]", "rate: [4, -1]"), "rate[1] = -1"),
+    (lambda s: s.replace("kind: simulate", "kind: drive"), "kind"),
+    (lambda s: s.replace("kind: simulate\n", ""), "add 'kind: simulate'"),
+])
+def test_a_bad_driven_study_exits_2_naming_the_key(tmp_path, edit, words):
+    study = tmp_path / "rates.yaml"
+    study.write_text(edit(SIM_STUDY))
+    out = trackstar("study", str(study), "--out", str(tmp_path / "out"), timeout=30)
+    assert out.returncode == 2 and words in out.stderr, out.stderr
+    assert not (tmp_path / "out").exists()

@@ -2,7 +2,8 @@
 
 Each finished run is committed at once (WAL mode), so Ctrl-C, a crash or ``kill -9`` loses no
 finished run and leaves a valid database. The schema (docs/studies.md) is versioned with
-``PRAGMA user_version``. Only the study's driver writes; a run that failed is stored with its
+``PRAGMA user_version``: planning runs in ``runs`` (with ``cost_over_time``), driven runs in
+``sim_runs``. Only the study's driver writes; a run that failed is stored with its
 error and replaced when the study is run again.
 """
 
@@ -14,16 +15,22 @@ import sqlite3
 from importlib.metadata import version
 from pathlib import Path
 
-from app.study.spec import Run
 
-__all__ = ["COLUMNS", "Results", "StudyMismatch"]
+__all__ = ["COLUMNS", "TABLES", "Results", "StudyMismatch"]
 
 SCHEMA_VERSION = 1
 KEY = ("scenario", "planner", "steering", "parameters", "budget_iterations", "budget_time_s",
        "seed")
 OUTCOME = ("solved", "cost", "time_to_first_solution_s", "iterations", "nodes",
            "collision_checks", "min_clearance_m", "iterations_per_s", "wall_s", "error")
-COLUMNS = ("id", "study", *KEY, *OUTCOME, "trackstar_version", "finished_at")
+SIM_KEY = ("scenario", "parameters", "seed")
+SIM_OUTCOME = ("reached", "collisions", "min_clearance_m", "time_to_goal_s", "cycle_p50_ms",
+               "cycle_p99_ms", "replans", "emergency_stops", "max_lateral_error_m", "wall_s",
+               "error")
+COLUMNS = {"plan": ("id", "study", *KEY, *OUTCOME, "trackstar_version", "finished_at"),
+           "simulate": ("id", "study", *SIM_KEY, *SIM_OUTCOME, "trackstar_version",
+                        "finished_at")}
+TABLES = {"plan": "runs", "simulate": "sim_runs"}
 
 _SCHEMA = f"""
 CREATE TABLE IF NOT EXISTS study (
@@ -42,6 +49,13 @@ CREATE TABLE IF NOT EXISTS cost_over_time (
     run_id INTEGER NOT NULL REFERENCES runs (id) ON DELETE CASCADE, iteration INTEGER,
     t_s REAL NOT NULL, cost REAL NOT NULL);
 CREATE INDEX IF NOT EXISTS cost_over_time_run ON cost_over_time (run_id);
+CREATE TABLE IF NOT EXISTS sim_runs (
+    id INTEGER PRIMARY KEY, study TEXT NOT NULL, scenario TEXT NOT NULL,
+    parameters TEXT NOT NULL, seed INTEGER NOT NULL, reached INTEGER, collisions INTEGER,
+    min_clearance_m REAL, time_to_goal_s REAL, cycle_p50_ms REAL, cycle_p99_ms REAL,
+    replans INTEGER, emergency_stops INTEGER, max_lateral_error_m REAL, wall_s REAL,
+    error TEXT, trackstar_version TEXT NOT NULL, finished_at TEXT NOT NULL,
+    UNIQUE (study, scenario, parameters, seed));
 PRAGMA user_version = {SCHEMA_VERSION};
 """
 
@@ -53,10 +67,12 @@ class StudyMismatch(ValueError):
 class Results:
     """``DIR/results.sqlite`` of one study."""
 
-    def __init__(self, directory: Path, study: str, file_text: str) -> None:
+    def __init__(self, directory: Path, study: str, kind: str, file_text: str) -> None:
         directory.mkdir(parents=True, exist_ok=True)
         self.path = directory / "results.sqlite"
         self.study = study
+        self.table, self.columns = TABLES[kind], COLUMNS[kind]
+        self._key = KEY if kind == "plan" else SIM_KEY
         self.version = version("trackstar")
         self._db = sqlite3.connect(self.path, isolation_level=None)
         self._db.execute("PRAGMA journal_mode = WAL")
@@ -73,38 +89,39 @@ class Results:
 
     def done(self) -> set[tuple]:
         """Keys of the runs that finished (failed runs are done again)."""
-        rows = self._db.execute(f"SELECT {', '.join(KEY)} FROM runs WHERE study = ? AND error "
-                                f"IS NULL", (self.study,))
+        rows = self._db.execute(f"SELECT {', '.join(self._key)} FROM {self.table} WHERE "
+                                f"study = ? AND error IS NULL", (self.study,))
         return set(rows)
 
-    def add(self, run: Run, outcome: dict, cost_over_time: list) -> None:
-        """Store one run and its cost curve in one transaction (replacing a failed attempt)."""
-        key = run.key
+    def add(self, run, outcome: dict, cost_over_time: list) -> None:
+        """Store one run (and a planning run's cost curve) in one transaction, replacing a
+        failed attempt."""
+        match = " AND ".join(f"{k} IS ?" for k in self._key)
+        outcomes = self.columns[2 + len(self._key):-2]
         with self._db:  # BEGIN … COMMIT
             self._db.execute("BEGIN")
-            self._db.execute(
-                "DELETE FROM runs WHERE study = ? AND scenario = ? AND planner = ? AND "
-                "steering = ? AND parameters = ? AND budget_iterations IS ? AND budget_time_s "
-                "IS ? AND seed = ?", (self.study, *key))
+            self._db.execute(f"DELETE FROM {self.table} WHERE study = ? AND {match}",
+                             (self.study, *run.key))
             cur = self._db.execute(
-                f"INSERT INTO runs ({', '.join(COLUMNS[1:])}) VALUES "
-                f"({', '.join('?' * (len(COLUMNS) - 1))})",
-                (self.study, *key, *(outcome.get(c) for c in OUTCOME), self.version, _now()))
+                f"INSERT INTO {self.table} ({', '.join(self.columns[1:])}) VALUES "
+                f"({', '.join('?' * (len(self.columns) - 1))})",
+                (self.study, *run.key, *(outcome.get(c) for c in outcomes), self.version,
+                 _now()))
             self._db.executemany("INSERT INTO cost_over_time VALUES (?, ?, ?, ?)",
                                  [(cur.lastrowid, *row) for row in cost_over_time])
 
     def count(self) -> tuple[int, int]:
         """(runs stored, of which failed)."""
-        return self._db.execute("SELECT COUNT(*), COUNT(error) FROM runs WHERE study = ?",
-                                (self.study,)).fetchone()
+        return self._db.execute(f"SELECT COUNT(*), COUNT(error) FROM {self.table} WHERE "
+                                f"study = ?", (self.study,)).fetchone()
 
     def write_csv(self, path: Path) -> None:
-        """The `runs` table as CSV: a header of the column names, one line per run."""
-        rows = self._db.execute(f"SELECT {', '.join(COLUMNS)} FROM runs WHERE study = ? "
-                                f"ORDER BY id", (self.study,))
+        """The runs table as CSV: a header of the column names, one line per run."""
+        rows = self._db.execute(f"SELECT {', '.join(self.columns)} FROM {self.table} WHERE "
+                                f"study = ? ORDER BY id", (self.study,))
         with path.open("w", newline="", encoding="utf-8") as out:
             writer = csv.writer(out)
-            writer.writerow(COLUMNS)
+            writer.writerow(self.columns)
             writer.writerows(rows)
 
     def close(self) -> None:

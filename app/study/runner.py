@@ -15,7 +15,7 @@ from app.planning import run_plan
 from app.pool import first_line, start_pool, stop_pool
 from app.study.report import write_report
 from app.study.results import Results
-from app.study.spec import Run, Study
+from app.study.spec import Run, SimRun, Study
 
 __all__ = ["Summary", "execute", "run_study"]
 
@@ -36,29 +36,48 @@ class Summary:
     report: str | None
 
 
-def execute(scenario: planner.Scenario, run: Run) -> tuple[dict, list]:
-    """One run, in a worker: its outcome row and its cost curve (iteration, t_s, cost) — the
-    numbers `trackstar plan --json` prints for the same options."""
+def execute(scenario: planner.Scenario, run: Run | SimRun) -> tuple[dict, list]:
+    """One run, in a worker: its outcome row and (planning runs) its cost curve (iteration,
+    t_s, cost) — the numbers `trackstar plan --json` (`simulate --json`) prints for the same
+    options."""
     started = time.perf_counter()
     try:
-        report = run_plan(scenario, run.options())
+        outcome, curve = (_simulate(scenario, run) if isinstance(run, SimRun) else
+                          _plan(scenario, run))
     except Exception as exc:  # noqa: BLE001  (stored with the run; the study goes on)
-        return {"error": first_line(exc), "wall_s": time.perf_counter() - started}, []
+        outcome, curve = {"error": first_line(exc)}, []
+    return outcome | {"wall_s": time.perf_counter() - started}, curve
+
+
+def _plan(scenario: planner.Scenario, run: Run) -> tuple[dict, list]:
+    report = run_plan(scenario, run.options())
     rate = report.iterations / report.planning_time_s if report.planning_time_s > 0 else None
     outcome = {
         "solved": int(report.solved), "cost": report.cost,
         "time_to_first_solution_s": report.time_to_first_solution_s,
         "iterations": report.iterations, "nodes": report.nodes,
         "collision_checks": report.collision_checks, "min_clearance_m": report.min_clearance_m,
-        "iterations_per_s": rate, "wall_s": time.perf_counter() - started}
+        "iterations_per_s": rate}
     return outcome, [(i, t, cost) for t, cost, i in report.cost_over_time]
+
+
+def _simulate(scenario: planner.Scenario, run: SimRun) -> tuple[dict, list]:
+    from planner.sim import simulate
+
+    problem = planner.compile_problem(scenario)
+    s = simulate(problem.scenario, run.options().settings(), problem).summary
+    return {"reached": int(s["reached_goal"]), "collisions": s["collisions"],
+            "min_clearance_m": s["min_clearance_m"], "time_to_goal_s": s["time_to_goal_s"],
+            "cycle_p50_ms": s["cycle_ms"]["p50"], "cycle_p99_ms": s["cycle_ms"]["p99"],
+            "replans": s["replans"], "emergency_stops": s["emergency_stops"],
+            "max_lateral_error_m": s["cross_track_error_m"]["max"]}, []
 
 
 def run_study(study: Study, out: Path, workers: int) -> Summary:
     """Run what ``out`` does not hold yet. Ctrl-C stops the workers and raises
     KeyboardInterrupt once every finished run is stored."""
     started = time.perf_counter()
-    results = Results(out, study.name, study.text)
+    results = Results(out, study.name, study.kind, study.text)
     try:
         done = results.done()
         todo = [run for run in study.runs if run.key not in done]
@@ -72,13 +91,13 @@ def run_study(study: Study, out: Path, workers: int) -> Summary:
         results.write_csv(out / "results.csv")
     finally:
         results.close()
-    report = write_report(results.path, out)
+    report = write_report(results.path, study.kind, out)
     return Summary(study.name, str(out), len(study.runs), stored - failed, skipped, failed,
                    time.perf_counter() - started, str(results.path), str(out / "results.csv"),
                    str(report))
 
 
-def _run_on_pool(study: Study, todo: list[Run], results: Results, workers: int) -> None:
+def _run_on_pool(study: Study, todo: list, results: Results, workers: int) -> None:
     bar = tqdm(total=len(todo), desc=study.name, unit="run", file=sys.stderr,
                disable=not sys.stderr.isatty())
     pool = start_pool(workers)
@@ -99,9 +118,10 @@ def _run_on_pool(study: Study, todo: list[Run], results: Results, workers: int) 
                 run = pending.pop(future)
                 outcome, curve = future.result()
                 results.add(run, outcome, curve)
-                solved += outcome.get("solved", 0)
+                solved += outcome.get("solved", outcome.get("reached", 0)) or 0
                 bar.update()
-                bar.set_postfix(solved=solved, refresh=False)
+                bar.set_postfix({"solved" if study.kind == "plan" else "reached": solved},
+                                refresh=False)
     finally:
         stop_pool(pool)
         bar.close()

@@ -1,9 +1,10 @@
 """The study file: YAML or JSON, validated before anything runs, expanded into runs.
 
-A run is one (scenario, planner, steering, parameter point, budget, seed); its key identifies
-it in the results, so a resumed or extended study redoes nothing. A parameter that a planner
-does not have (RRT has no γ, k or informed sampling) is dropped from its points, so such a
-planner runs once per point of the parameters it has.
+A planning run is one (scenario, planner, steering, parameter point, budget, seed), a driven run
+(``kind: simulate``) one (scenario, parameter point, seed); the key identifies a run in the
+results, so a resumed or extended study redoes nothing. A parameter that a planner does not have
+(RRT has no γ, k or informed sampling) is dropped from its points, so such a planner runs once
+per point of the parameters it has.
 """
 
 from __future__ import annotations
@@ -16,17 +17,21 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 import yaml
-from pydantic import Field, ValidationError, field_validator, model_validator
+from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 
 import planner
+from app.simulation import SimOptions
 from planner.options import PLANNERS, PlanOptions, PositiveFinite, Seed
 from planner.steering import STEERINGS, SteeringName
 from planner.validation import StrictModel, describe, suggest
 
-__all__ = ["PARAMETERS", "Run", "Study", "StudyError", "load_study"]
+__all__ = ["PARAMETERS", "SIM_PARAMETERS", "Run", "SimRun", "Study", "StudyError",
+           "load_study"]
 
-# The axes a study may sweep: `trackstar plan`'s options, under the same names.
+# The axes a study may sweep: `trackstar plan`'s and `trackstar simulate`'s options, under the
+# same names.
 PARAMETERS = ("eps", "gamma", "k_rrt", "goal_bias", "informed", "metric", "speed")
+SIM_PARAMETERS = tuple(k for k in SimOptions.model_fields if k != "seed")
 _RRTSTAR_ONLY = ("gamma", "k_rrt", "informed")
 
 Count = Annotated[int, Field(ge=1)]
@@ -95,16 +100,15 @@ class StudyFile(StrictModel):
 
     name: Annotated[str, Field(pattern=r"^[A-Za-z0-9_.-]+$", max_length=100)]
     description: str | None = None
-    kind: Literal["plan"] = "plan"
+    kind: Literal["plan", "simulate"] = "plan"
     scenarios: Annotated[list[str], Field(min_length=1)]
-    planners: Annotated[list[Literal[PLANNERS]], Field(min_length=1)]
-    steering: Annotated[list[SteeringName], Field(min_length=1)] = Field(
-        default_factory=lambda: [next(iter(STEERINGS))])
+    planners: Annotated[list[Literal[PLANNERS]], Field(min_length=1)] | None = None
+    steering: Annotated[list[SteeringName], Field(min_length=1)] | None = None
     parameters: dict[str, Annotated[list[Any], Field(min_length=1)] | Range] = Field(
         default_factory=dict)
     sample: Sample | None = None
     seeds: Annotated[list[Seed], Field(min_length=1)] = Field(default_factory=lambda: [0])
-    budget: Budget
+    budget: Budget | None = None
 
     @field_validator("seeds", mode="before")
     @classmethod
@@ -139,22 +143,41 @@ class StudyFile(StrictModel):
 
     @field_validator("parameters")
     @classmethod
-    def _values(cls, parameters: dict) -> dict:
-        """Known names, and each value (a range's ends) as `PlanOptions` validates it, so the
-        study and `trackstar plan` agree."""
+    def _values(cls, parameters: dict, info: ValidationInfo) -> dict:
+        """Known names, and each value (a range's ends) as `PlanOptions` (or `SimOptions`)
+        validates it, so the study and `trackstar plan` (`simulate`) agree."""
+        simulate = info.data.get("kind") == "simulate"
+        names, model = (SIM_PARAMETERS, SimOptions) if simulate else (PARAMETERS, PlanOptions)
         for key, values in parameters.items():
-            if key not in PARAMETERS:
-                raise ValueError(f"unknown parameter '{key}'{suggest(key, PARAMETERS)}")
+            if key not in names:
+                hint = ("; it is an option of trackstar simulate: add 'kind: simulate'"
+                        if not simulate and key in SIM_PARAMETERS else "")
+                raise ValueError(f"unknown parameter '{key}'{suggest(key, names)}{hint}")
             named = ([(f"{key}.min", values.min), (f"{key}.max", values.max)]
                      if isinstance(values, Range) else
                      [(f"{key}[{i}]", v) for i, v in enumerate(values)])
             for where, value in named:
                 try:
-                    PlanOptions(**{key: value})
+                    model(**{key: value})
                 except ValidationError as exc:
                     msg = exc.errors()[0]["msg"]
                     raise ValueError(f"{where} = {value!r}: {msg}") from None
         return parameters
+
+    @model_validator(mode="after")
+    def _keys_of_the_kind(self) -> StudyFile:
+        """A planning study names its planners and budget; a driven one replans as `trackstar
+        simulate` does (RRT*, Dubins, its budget per cycle), so it has none of the three."""
+        if self.kind == "plan":
+            for key in ("planners", "budget"):
+                if getattr(self, key) is None:
+                    raise ValueError(f"{key}: required for a planning study")
+        else:
+            for key in ("planners", "steering", "budget"):
+                if getattr(self, key) is not None:
+                    raise ValueError(f"{key}: a simulate study replans as trackstar simulate "
+                                     f"does; leave it out")
+        return self
 
     @model_validator(mode="after")
     def _ranges_need_a_sample(self) -> StudyFile:
@@ -175,8 +198,35 @@ class StudyFile(StrictModel):
                  for k, v in self.parameters.items()} for _ in range(self.sample.n)]
 
 
+class _Point:
+    parameters: dict
+
+    @property
+    def parameters_json(self) -> str:
+        """The run's parameter values as a JSON object, keys sorted: part of its key."""
+        return json.dumps(self.parameters, sort_keys=True)
+
+
 @dataclass(frozen=True)
-class Run:
+class SimRun(_Point):
+    """One driven run: what `trackstar simulate` does with these options."""
+
+    scenario: str
+    parameters: dict = field(hash=False, compare=False)
+    seed: int
+
+    @property
+    def key(self) -> tuple:
+        return (self.scenario, self.parameters_json, self.seed)
+
+    def options(self) -> SimOptions:
+        return SimOptions(seed=self.seed, **self.parameters)
+
+
+@dataclass(frozen=True)
+class Run(_Point):
+    """One planning run: what `trackstar plan` does with these options."""
+
     scenario: str  # the scenario's name
     planner: str
     steering: str
@@ -184,10 +234,6 @@ class Run:
     budget_iterations: int | None
     budget_time_s: float | None
     seed: int
-
-    @property
-    def parameters_json(self) -> str:
-        return json.dumps(self.parameters, sort_keys=True)
 
     @property
     def key(self) -> tuple:
@@ -206,9 +252,10 @@ class Study:
     """A validated study: its file's text, its scenarios (by name) and its runs."""
 
     name: str
+    kind: str
     text: str
     scenarios: dict[str, planner.Scenario]
-    runs: list[Run]
+    runs: list[Run] | list[SimRun]
 
 
 def _has(planner_name: str, point: dict) -> dict:
@@ -248,15 +295,23 @@ def load_study(path: str | Path) -> Study:
     for i, source in enumerate(spec.scenarios):
         scenario = _scenario(source, path, f"scenarios[{i}]")
         scenarios.setdefault(scenario.name, scenario)
-    seeds = list(range(spec.seeds)) if isinstance(spec.seeds, int) else spec.seeds
+    return Study(spec.name, spec.kind, text, scenarios, _runs(spec, list(scenarios)))
+
+
+def _runs(spec: StudyFile, scenarios: list[str]) -> list[Run] | list[SimRun]:
+    """Every run of the study, in grid order, each once."""
     points = spec.points()
+    if spec.kind == "simulate":
+        return [SimRun(name, point, seed)
+                for name, point, seed in itertools.product(scenarios, points, spec.seeds)]
     runs, seen = [], set()
-    for name, planner_name, steering in itertools.product(scenarios, spec.planners,
-                                                          spec.steering):
+    steering = spec.steering or [next(iter(STEERINGS))]
+    for name, planner_name, steer in itertools.product(scenarios, spec.planners, steering):
         for point in (_has(planner_name, p) for p in points):
-            for (iterations, time_s), seed in itertools.product(spec.budget.points(), seeds):
-                run = Run(name, planner_name, steering, point, iterations, time_s, seed)
+            for (iterations, time_s), seed in itertools.product(spec.budget.points(),
+                                                                spec.seeds):
+                run = Run(name, planner_name, steer, point, iterations, time_s, seed)
                 if run.key not in seen:
                     seen.add(run.key)
                     runs.append(run)
-    return Study(spec.name, text, scenarios, runs)
+    return runs
