@@ -14,6 +14,7 @@ import base64
 import html
 import io
 import json
+import math
 import re
 import sqlite3
 import warnings
@@ -202,7 +203,7 @@ def _best(kind: Kind, settings: dict[str, Setting]) -> Setting:
     """Highest success rate, then the lowest median of ``kind.best``."""
     def rank(s: Setting):
         tie = s.median(kind.best)
-        return (-s.rate(kind.success), tie if tie == tie else float("inf"))
+        return (-s.rate(kind.success), tie if math.isfinite(tie) else math.inf)
 
     return min(settings.values(), key=rank)
 

@@ -15,7 +15,6 @@ import sqlite3
 from importlib.metadata import version
 from pathlib import Path
 
-
 __all__ = ["COLUMNS", "TABLES", "Results", "StudyMismatch"]
 
 SCHEMA_VERSION = 1
