@@ -137,6 +137,11 @@ class Planner:
         return self._clock.first_solution_s
 
     @property
+    def cost_over_time(self) -> list[tuple[float, float, int]]:
+        """(planning seconds, best cost, iteration) at each improvement so far."""
+        return list(self._clock.cost_over_time)
+
+    @property
     def poses(self) -> np.ndarray:
         """A read-only *live* view of the nodes' poses: read it on the planner's thread (in a
         listener); `snapshot()` gives a copy for anywhere else."""

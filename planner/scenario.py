@@ -48,11 +48,16 @@ class Footprint(StrictModel):
     width: Positive
     rear_overhang: Annotated[float, Field(ge=0)] | None = None
 
+    def overhang(self, wheelbase: float) -> float:
+        """The rear overhang: as given, else the wheelbase centred in the length."""
+        if self.rear_overhang is not None:
+            return self.rear_overhang
+        return max(self.length - wheelbase, 0.0) / 2
+
     def discs(self, wheelbase: float) -> list[tuple[float, float]]:
         """Cover the rectangle exactly by n = ⌈length / width⌉ equal discs along its axis:
         (offset from the rear axle along the heading, radius) rows."""
-        overhang = (self.rear_overhang if self.rear_overhang is not None
-                    else max(self.length - wheelbase, 0.0) / 2)
+        overhang = self.overhang(wheelbase)
         n = max(1, math.ceil(self.length / self.width - 1e-9))
         half = self.length / (2 * n)
         radius = math.hypot(half, self.width / 2)

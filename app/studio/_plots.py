@@ -85,10 +85,11 @@ class Profiles:
         self.curvature.data = kappa
         self.steering.data = steer
 
-    def show_cost(self, cost_over_time: list[tuple[float, float]]) -> None:
+    def show_cost(self, cost_over_time: list[tuple[float, float, int]]) -> None:
+        """The planner's best cost against its planning time."""
         if not cost_over_time:
             return
-        t, c = np.array(cost_over_time).T
+        t, c = np.array(cost_over_time)[:, :2].T
         if len(t) == 1:
             t, c = np.array([t[0], t[0] + 1e-3]), np.array([c[0], c[0]])
         self.cost.data = (t, c)

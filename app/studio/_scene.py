@@ -176,8 +176,7 @@ def _car_ring(vehicle, marker: float) -> np.ndarray:
         a = np.linspace(0, 2 * math.pi, 32, endpoint=False)
         r = vehicle.radius or 2 * marker
         return np.column_stack([r * np.cos(a), r * np.sin(a)])
-    back = -(fp.rear_overhang if fp.rear_overhang is not None
-             else max(fp.length - vehicle.wheelbase, 0.0) / 2)
+    back = -fp.overhang(vehicle.wheelbase)
     w = fp.width / 2
     return np.array([[back, -w], [back + fp.length, -w], [back + fp.length, w], [back, w]])
 

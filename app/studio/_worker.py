@@ -35,7 +35,7 @@ class Live:
     best_version: int = 0
     metrics: dict = field(default_factory=dict)
     metrics_version: int = 0
-    cost_over_time: list = field(default_factory=list)  # (wall s, cost)
+    cost_over_time: list = field(default_factory=list)  # the planner's (s, cost, iteration)
     step: dict | None = None
     step_version: int = 0
     state: str = "ready"
@@ -169,7 +169,7 @@ class PlannerWorker:
             self._best = cost
             live.best_path = run.dense_path(0.05)
             live.best_version += 1
-            live.cost_over_time.append((self._wall, cost))
+            live.cost_over_time = run.cost_over_time
         if now - self._last_metrics >= 0.5 or self._stepping:
             self._last_metrics = now
             self._publish_metrics()
