@@ -14,7 +14,14 @@ from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
 from fastapi_offline import FastAPIOffline
 
-from app.server import routes_jobs, routes_plan, routes_scenarios, routes_simulations, routes_tracks
+from app.server import (
+    routes_jobs,
+    routes_plan,
+    routes_scenarios,
+    routes_simulations,
+    routes_studies,
+    routes_tracks,
+)
 from app.server.jobs import Planning
 from app.server.models import INVALID_SCENARIO, Health
 from app.server.store import Store
@@ -95,6 +102,7 @@ def create_app(settings: ServerSettings) -> FastAPI:
         store = Store(settings.data_dir / DATABASE)
         planning = Planning(store, settings.max_plan_s, settings.workers)
         app.state.store, app.state.planning = store, planning
+        routes_studies.resume_unfinished(store, planning)
         try:
             yield
         finally:
@@ -139,7 +147,7 @@ def create_app(settings: ServerSettings) -> FastAPI:
         return FileResponse(STATIC / "index.html")
 
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
-    for module in (routes_tracks, routes_scenarios, routes_plan, routes_jobs,
+    for module in (routes_tracks, routes_scenarios, routes_plan, routes_jobs, routes_studies,
                    routes_simulations):
         app.include_router(module.router, prefix="/api/v1")
     return app

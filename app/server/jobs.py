@@ -19,6 +19,10 @@ from app.planning import TrackSource, check_scenario, run_plan
 from app.pool import first_line, machine_workers, start_pool, stop_pool
 from app.server.store import Store
 from app.simulation import SimOptions, read_progress, run_simulation
+from app.study.report import write_report
+from app.study.results import Results
+from app.study.runner import execute
+from app.study.spec import Study
 from planner.options import PlanOptions
 from planner.report import PlanReport
 from planner.scenario import Scenario
@@ -40,6 +44,7 @@ class Planning:
         self._jobs: dict[str, asyncio.Task] = {}  # batch jobs and simulations
         self.sim_dir = store.path.parent / "simulations"  # per-run log CSV and progress files
         self.sim_dir.mkdir(exist_ok=True)
+        self.studies_dir = store.path.parent / "studies"  # one results directory per study
         store.fail_unfinished(CRASHED)
 
     def _start_pool(self) -> ProcessPoolExecutor:
@@ -121,6 +126,49 @@ class Planning:
         finally:
             progress.unlink(missing_ok=True)
             self._jobs.pop(sim_id, None)
+
+    # -- studies: the runs of app.study, each stored in the study's own results directory
+    def study_dir(self, study_id: str) -> Path:
+        return self.studies_dir / study_id
+
+    def start_study(self, study_id: str, study: Study) -> None:
+        """Run (or resume) a study in the background: the runs its directory does not hold."""
+        task = self._study(study_id, study)
+        self._jobs[study_id] = asyncio.get_running_loop().create_task(task)
+
+    async def _study(self, study_id: str, study: Study) -> None:
+        out = self.study_dir(study_id)
+        results = Results(out, study.name, study.kind, study.text)
+        free = asyncio.Semaphore(self.workers)
+
+        async def one(run) -> None:
+            async with free:
+                outcome, curve = await self._call(execute, study.scenarios[run.scenario], run,
+                                                  self.max_plan_s)
+            results.add(run, outcome, curve)
+
+        try:
+            done = results.done()
+            todo = [run for run in study.runs if run.key not in done]
+            self.store.set_study(study_id, "running", skipped=len(study.runs) - len(todo))
+            async with asyncio.TaskGroup() as group:
+                for run in todo:
+                    group.create_task(one(run))
+            results.write_csv(out / "results.csv")
+            await asyncio.to_thread(write_report, results.path, study.kind, out)
+        except* Exception as failed:  # noqa: BLE001  (a worker died: the stored runs stay)
+            self.store.set_study(study_id, "failed", error=first_line(failed.exceptions[0]))
+        else:
+            self.store.set_study(study_id, "done")
+        finally:
+            results.close()
+            self._jobs.pop(study_id, None)
+
+    def cancel_study(self, study_id: str) -> None:
+        self.store.set_study(study_id, "cancelled")
+        task = self._jobs.get(study_id)
+        if task is not None:
+            task.cancel()
 
     def cancel(self, job_id: str) -> None:
         self.store.set_job_status(job_id, "cancelled")

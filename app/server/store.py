@@ -1,5 +1,6 @@
-"""The server's data: one SQLite file (WAL) with uploaded tracks, scenarios, batch jobs and
-simulations (their per-tick logs are CSV files beside it, see `jobs.Planning`).
+"""The server's data: one SQLite file (WAL) with uploaded tracks, scenarios, batch jobs,
+simulations and studies (simulation logs and each study's results directory are beside it,
+see `jobs.Planning`).
 
 Schema changes are appended to `MIGRATIONS`; `schema_version` records how many have run, so a
 data directory from an older release is upgraded on start and never rebuilt. One connection is
@@ -37,6 +38,12 @@ MIGRATIONS = [
     CREATE TABLE simulations (id TEXT PRIMARY KEY, status TEXT NOT NULL, scenario TEXT NOT NULL,
                               settings TEXT NOT NULL, summary TEXT, error TEXT,
                               created REAL NOT NULL);
+    """,
+    """
+    CREATE TABLE studies (id TEXT PRIMARY KEY, name TEXT NOT NULL, status TEXT NOT NULL,
+                          body TEXT NOT NULL, total INTEGER NOT NULL,
+                          skipped INTEGER NOT NULL DEFAULT 0, error TEXT,
+                          created REAL NOT NULL);
     """,
 ]
 
@@ -179,6 +186,36 @@ class Store:
         self._write(f"UPDATE simulations SET status = ?, summary = ?, error = ? WHERE id = ? "
                     f"AND status IN {UNFINISHED}", status,
                     json.dumps(summary) if summary is not None else None, error, sim_id)
+
+
+    # studies: the rows say what was asked and how far it got; the runs are in each study's
+    # own results.sqlite (app.study.results)
+    def add_study(self, name: str, body: dict[str, Any], total: int) -> str:
+        study_id = new_id()
+        self._write("INSERT INTO studies VALUES (?, ?, 'queued', ?, ?, 0, NULL, ?)", study_id,
+                    name, json.dumps(body), total, time.time())
+        return study_id
+
+    def study(self, study_id: str) -> dict | None:
+        row = self._one("SELECT * FROM studies WHERE id = ?", study_id)
+        if row is not None:
+            row["body"] = json.loads(row["body"])
+        return row
+
+    def studies(self) -> list[dict]:
+        return self._all("SELECT id, name, status, total, skipped, error FROM studies "
+                         "ORDER BY created")
+
+    def unfinished_studies(self) -> list[dict]:
+        return [self.study(r["id"]) for r in self._all(
+            f"SELECT id FROM studies WHERE status IN {UNFINISHED} ORDER BY created")]
+
+    def set_study(self, study_id: str, status: str, *, skipped: int | None = None,
+                  error: str | None = None) -> None:
+        """Move an unfinished study on; a finished one stays as it is."""
+        self._write(f"UPDATE studies SET status = ?, skipped = IFNULL(?, skipped), error = ? "
+                    f"WHERE id = ? AND status IN {UNFINISHED}", status, skipped, error,
+                    study_id)
 
 
 def _scenario(row: dict) -> dict:

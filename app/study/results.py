@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import csv
 import datetime as dt
+import io
 import sqlite3
 from importlib.metadata import version
 from pathlib import Path
 
-__all__ = ["COLUMNS", "TABLES", "Results", "StudyMismatch"]
+__all__ = ["COLUMNS", "TABLES", "Results", "StudyMismatch", "runs_csv"]
 
 SCHEMA_VERSION = 1
 KEY = ("scenario", "planner", "steering", "parameters", "budget_iterations", "budget_time_s",
@@ -115,13 +116,8 @@ class Results:
                                 f"study = ?", (self.study,)).fetchone()
 
     def write_csv(self, path: Path) -> None:
-        """The runs table as CSV: a header of the column names, one line per run."""
-        rows = self._db.execute(f"SELECT {', '.join(self.columns)} FROM {self.table} WHERE "
-                                f"study = ? ORDER BY id", (self.study,))
-        with path.open("w", newline="", encoding="utf-8") as out:
-            writer = csv.writer(out)
-            writer.writerow(self.columns)
-            writer.writerows(rows)
+        """The runs table as CSV (`runs_csv`)."""
+        path.write_text(runs_csv(self._db, self.table), encoding="utf-8")
 
     def close(self) -> None:
         self._db.close()
@@ -129,3 +125,13 @@ class Results:
 
 def _now() -> str:
     return dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
+
+
+def runs_csv(db: sqlite3.Connection, table: str) -> str:
+    """A runs table as CSV: a header of the column names, one line per run."""
+    kind = next(k for k, t in TABLES.items() if t == table)
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(COLUMNS[kind])
+    writer.writerows(db.execute(f"SELECT {', '.join(COLUMNS[kind])} FROM {table} ORDER BY id"))
+    return out.getvalue()

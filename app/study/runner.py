@@ -36,21 +36,22 @@ class Summary:
     report: str | None
 
 
-def execute(scenario: planner.Scenario, run: Run | SimRun) -> tuple[dict, list]:
+def execute(scenario: planner.Scenario, run: Run | SimRun,
+            max_time: float | None = None) -> tuple[dict, list]:
     """One run, in a worker: its outcome row and (planning runs) its cost curve (iteration,
     t_s, cost) — the numbers `trackstar plan --json` (`simulate --json`) prints for the same
-    options."""
+    options. ``max_time`` caps a plan's time (a server's --max-plan-s)."""
     started = time.perf_counter()
     try:
         outcome, curve = (_simulate(scenario, run) if isinstance(run, SimRun) else
-                          _plan(scenario, run))
+                          _plan(scenario, run, max_time))
     except Exception as exc:  # noqa: BLE001  (stored with the run; the study goes on)
         outcome, curve = {"error": first_line(exc)}, []
     return outcome | {"wall_s": time.perf_counter() - started}, curve
 
 
-def _plan(scenario: planner.Scenario, run: Run) -> tuple[dict, list]:
-    report = run_plan(scenario, run.options())
+def _plan(scenario: planner.Scenario, run: Run, max_time: float | None) -> tuple[dict, list]:
+    report = run_plan(scenario, run.options(), max_time=max_time)
     rate = report.iterations / report.planning_time_s if report.planning_time_s > 0 else None
     outcome = {
         "solved": int(report.solved), "cost": report.cost,

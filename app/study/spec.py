@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import json
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -26,7 +27,7 @@ from planner.steering import STEERINGS, SteeringName
 from planner.validation import StrictModel, describe, suggest
 
 __all__ = ["PARAMETERS", "SIM_PARAMETERS", "Run", "SimRun", "Study", "StudyError",
-           "load_study"]
+           "load_study", "parse_study"]
 
 # The axes a study may sweep: `trackstar plan`'s and `trackstar simulate`'s options, under the
 # same names.
@@ -101,7 +102,7 @@ class StudyFile(StrictModel):
     name: Annotated[str, Field(pattern=r"^[A-Za-z0-9_.-]+$", max_length=100)]
     description: str | None = None
     kind: Literal["plan", "simulate"] = "plan"
-    scenarios: Annotated[list[str], Field(min_length=1)]
+    scenarios: Annotated[list[str | dict[str, Any]], Field(min_length=1)]
     planners: Annotated[list[Literal[PLANNERS]], Field(min_length=1)] | None = None
     steering: Annotated[list[SteeringName], Field(min_length=1)] | None = None
     parameters: dict[str, Annotated[list[Any], Field(min_length=1)] | Range] = Field(
@@ -264,17 +265,32 @@ def _has(planner_name: str, point: dict) -> dict:
             if planner_name == "rrtstar" or k not in _RRTSTAR_ONLY}
 
 
-def _scenario(source: str, study: Path, where: str) -> planner.Scenario:
-    """A path relative to the study file, else a bundled scenario's name."""
-    path = study.parent / source
+def parse_study(data: Any, text: str, resolve: Callable[[Any], planner.Scenario],
+                origin: str = "") -> Study:
+    """Validate and expand a decoded study; ``resolve`` turns an entry of ``scenarios`` (a
+    name, a path, an id, an object) into a `planner.Scenario` or raises ScenarioError.
+    Raises StudyError naming the key, led by ``origin`` (the file) when given."""
+    lead = f"{origin}: " if origin else ""
+    if not isinstance(data, dict):
+        raise StudyError(f"{lead}a study is a mapping of keys, got {type(data).__name__}")
     try:
-        return planner.load_scenario(path if path.is_file() else source)
-    except planner.ScenarioError as exc:
-        raise StudyError(f"{study}: {where} ({source}): {exc}") from None
+        spec = StudyFile.model_validate(data)
+    except ValidationError as exc:
+        raise StudyError(f"{lead}{describe(exc)}") from None
+    scenarios = {}
+    for i, source in enumerate(spec.scenarios):
+        try:
+            scenario = resolve(source)
+        except planner.ScenarioError as exc:
+            shown = f" ({source})" if isinstance(source, str) else ""
+            raise StudyError(f"{lead}scenarios[{i}]{shown}: {exc}") from None
+        scenarios.setdefault(scenario.name, scenario)
+    return Study(spec.name, spec.kind, text, scenarios, _runs(spec, list(scenarios)))
 
 
 def load_study(path: str | Path) -> Study:
-    """Read, validate and expand a study file; raises StudyError naming the key."""
+    """Read, validate and expand a study file; raises StudyError naming the key. Scenarios
+    are paths relative to the file, else bundled scenarios' names (or inline objects)."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -285,17 +301,14 @@ def load_study(path: str | Path) -> Study:
     except (json.JSONDecodeError, yaml.YAMLError) as exc:
         raise StudyError(f"{path}: not valid {'JSON' if path.suffix == '.json' else 'YAML'} "
                          f"({str(exc).splitlines()[0]})") from None
-    if not isinstance(data, dict):
-        raise StudyError(f"{path}: a study is a mapping of keys, got {type(data).__name__}")
-    try:
-        spec = StudyFile.model_validate(data)
-    except ValidationError as exc:
-        raise StudyError(f"{path}: {describe(exc)}") from None
-    scenarios = {}
-    for i, source in enumerate(spec.scenarios):
-        scenario = _scenario(source, path, f"scenarios[{i}]")
-        scenarios.setdefault(scenario.name, scenario)
-    return Study(spec.name, spec.kind, text, scenarios, _runs(spec, list(scenarios)))
+
+    def resolve(source) -> planner.Scenario:
+        if isinstance(source, dict):
+            return planner.parse_scenario(source)
+        beside = path.parent / source
+        return planner.load_scenario(beside if beside.is_file() else source)
+
+    return parse_study(data, text, resolve, str(path))
 
 
 def _runs(spec: StudyFile, scenarios: list[str]) -> list[Run] | list[SimRun]:
