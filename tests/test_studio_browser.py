@@ -418,3 +418,23 @@ def test_straight_line_steering_draws_the_classic_rrt_picture(browser, ui_url):
     # Its heading free, the robot goes the short way: a quarter lap back, not 3/4 ahead.
     assert 2.0 < metric(page, "cost") < 6.0
     page.close()
+
+
+def test_the_studies_folder_lists_the_servers_studies_and_downloads_a_report(browser, urls):
+    import httpx
+
+    body = {"name": "tiny", "scenarios": ["open_field"], "planners": ["rrt"], "seeds": 2,
+            "budget": {"iterations": 200}}
+    study = httpx.post(urls["api"] + "/studies", json=body, timeout=30).json()
+    poll(lambda: httpx.get(f"{urls['api']}/studies/{study['id']}", timeout=10).json(),
+         lambda s: s["status"] == "done", timeout=60)
+    page = open_tab(browser, urls["ui"])
+    show_folder(page, "Studies", "Refresh list")
+    click(page, "Refresh list")
+    page.get_by_text("2 of 2 runs").first.wait_for(timeout=15000)
+    with page.expect_download() as dl:
+        click(page, "Download report")
+    report = Path(dl.value.path()).read_text()
+    assert dl.value.suggested_filename == "tiny.html"
+    assert "<h1>Study tiny</h1>" in report and "data:image/png;base64," in report
+    page.close()

@@ -14,8 +14,9 @@ from app.cli._errors import user_errors
 
 
 def study(
-    file: Annotated[Path, typer.Argument(show_default=False, help="The study file (.yaml, .yml "
-                                         "or .json; docs/studies.md).")],
+    file: Annotated[str, typer.Argument(show_default=False, metavar="STUDY", help=(
+        "A study file (.yaml, .yml or .json; docs/studies.md) or the name of a study bundled "
+        "in app/study/library."))],
     out: Annotated[Path | None, typer.Option(help="Results directory [default: "
                                              "studies/NAME/].", show_default=False)] = None,
     workers: Annotated[int | None, typer.Option(min=1, help="Worker processes [default: the "

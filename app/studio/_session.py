@@ -9,6 +9,7 @@ does never shows in another. Each part owns its state and is its only writer:
 - `Sources` (_sources.py): the library, SVG and scenario files, the server's store;
 - `PlannerRun` (_planner_run.py): the planner's worker, its drawing, panels and Drive car;
 - `SimView` (_sim_view.py): the simulated car and its folder;
+- `StudiesView` (_studies.py): the server's parameter studies and their reports;
 - `SceneClock` (_clock.py): the one scene time they all draw at.
 
 The session wires the controls to them and does what spans parts: a new track or scenario
@@ -31,6 +32,7 @@ from app.studio._planner_run import PlannerRun
 from app.studio._sim_view import SimView
 from app.studio._sources import Sources
 from app.studio._stage import Stage
+from app.studio._studies import StudiesView
 from app.studio._track_drawing import TrackDrawing
 
 __all__ = ["Session"]
@@ -55,6 +57,7 @@ class Session:
         self.editor = Editor(client.scene, u, self.stage, self.apply_scenario, self.drawing.add,
                              self.notify)
         self.sim = SimView(client.gui, client.scene, self.clock)
+        self.studies = StudiesView(client.gui, client, api_url, self.notify)
         self._wire()
         self._unfitted_ticks = 10  # fit the view this many ticks after the browser's camera
         self.sources.show_library("thesis")

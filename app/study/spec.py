@@ -27,7 +27,7 @@ from planner.steering import STEERINGS, SteeringName
 from planner.validation import StrictModel, describe, suggest
 
 __all__ = ["PARAMETERS", "SIM_PARAMETERS", "Run", "SimRun", "Study", "StudyError",
-           "load_study", "parse_study"]
+           "load_study", "parse_study", "study_names"]
 
 # The axes a study may sweep: `trackstar plan`'s and `trackstar simulate`'s options, under the
 # same names.
@@ -288,10 +288,24 @@ def parse_study(data: Any, text: str, resolve: Callable[[Any], planner.Scenario]
     return Study(spec.name, spec.kind, text, scenarios, _runs(spec, list(scenarios)))
 
 
-def load_study(path: str | Path) -> Study:
-    """Read, validate and expand a study file; raises StudyError naming the key. Scenarios
-    are paths relative to the file, else bundled scenarios' names (or inline objects)."""
-    path = Path(path)
+LIBRARY = Path(__file__).parent / "library"
+
+
+def study_names() -> list[str]:
+    """The studies bundled with Trackstar (app/study/library/)."""
+    return sorted(p.stem for p in LIBRARY.glob("*.yaml"))
+
+
+def load_study(source: str | Path) -> Study:
+    """Read, validate and expand a study file — or, when no such file exists, a bundled
+    study by name; raises StudyError naming the key. Scenarios are paths relative to the
+    file, else bundled scenarios' names (or inline objects)."""
+    path = Path(source)
+    if not path.exists() and str(source) in study_names():
+        path = LIBRARY / f"{source}.yaml"
+    elif not path.exists():
+        raise StudyError(f"no such study file or bundled study: {source} (bundled: "
+                         f"{', '.join(study_names())})")
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
