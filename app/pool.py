@@ -15,14 +15,14 @@ import threading
 import time
 from concurrent.futures import ProcessPoolExecutor
 
-from planner.rrt import warm_up
-
 __all__ = ["first_line", "machine_workers", "start_pool", "stop_pool"]
 
 PARENT_POLL_S = 0.5
 
 
 def _worker_start(parent: int) -> None:
+    from planner.rrt import warm_up  # here: importing the pool loads no kernels
+
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     threading.Thread(target=_exit_with_parent, args=(parent,), daemon=True,
                      name="exit-with-parent").start()

@@ -253,3 +253,29 @@ def test_a_bad_driven_study_is_refused_naming_the_key(tmp_path, edit, words):
     study.write_text(edit(SIM_STUDY))
     with pytest.raises(StudyError, match=re.escape(words)):
         load_study(study)
+
+
+def test_ray_stores_the_same_rows_as_the_local_pool_and_leaves_no_process(study_file,
+                                                                          tmp_path):
+    pytest.importorskip("ray")
+    study_file.write_text(STUDY.replace(", ./my/slalom.json", "").replace("seeds: 2", "seeds: 1"))
+    local, ray = tmp_path / "local", tmp_path / "ray"
+    assert trackstar("study", str(study_file), "--out", str(local)).returncode == 0
+    out = trackstar("study", str(study_file), "--out", str(ray), "--backend", "ray",
+                    "--workers", "2", "--json", timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert rows(ray) == rows(local) and len(rows(ray)) == 4
+    left = subprocess.run(["pgrep", "-f", "raylet|gcs_server"], capture_output=True, text=True)
+    assert left.stdout.strip() == "", "Ray processes outlived the command"
+
+
+def test_without_ray_the_ray_backend_says_how_to_install_it(study_file, tmp_path):
+    fake = tmp_path / "no_ray" / "ray"
+    fake.mkdir(parents=True)
+    (fake / "__init__.py").write_text("raise ImportError('no ray here')\n")
+    env = {**__import__("os").environ, "PYTHONPATH": str(fake.parent)}
+    out = subprocess.run(["trackstar", "study", str(study_file), "--out", str(tmp_path / "o"),
+                          "--backend", "ray"], capture_output=True, text=True, env=env,
+                         timeout=60)
+    assert out.returncode == 2 and "pip install 'trackstar[ray]'" in out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1

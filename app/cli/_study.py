@@ -6,11 +6,14 @@ import dataclasses
 import json
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import typer
 
 from app.cli._errors import user_errors
+from app.study.backends import BACKENDS
+
+Backend = Literal[tuple(BACKENDS)]
 
 
 def study(
@@ -21,6 +24,10 @@ def study(
                                              "studies/NAME/].", show_default=False)] = None,
     workers: Annotated[int | None, typer.Option(min=1, help="Worker processes [default: the "
                                                 "CPU count].", show_default=False)] = None,
+    backend: Annotated[Backend, typer.Option(help="Where the runs execute: this machine's "
+                                             "process pool, or Ray (the cluster in RAY_ADDRESS, "
+                                             "else a local one; pip install "
+                                             "'trackstar[ray]').")] = "local",
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Run every planning run of a study; runs already stored in --out are skipped."""
@@ -30,10 +37,11 @@ def study(
     from app.study.spec import load_study
 
     with user_errors():
+        BACKENDS[backend].check()
         spec = load_study(file)
         out = out or Path("studies") / spec.name
         try:
-            summary = run_study(spec, out, workers or machine_workers())
+            summary = run_study(spec, out, workers or machine_workers(), backend)
         except StudyMismatch as exc:
             raise ValueError(str(exc)) from None
         except KeyboardInterrupt:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import sys
 import time
-from concurrent.futures import FIRST_COMPLETED, wait
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -12,7 +11,8 @@ from tqdm import tqdm
 
 import planner
 from app.planning import run_plan
-from app.pool import first_line, start_pool, stop_pool
+from app.pool import first_line
+from app.study.backends import open_backend
 from app.study.report import write_report
 from app.study.results import Results
 from app.study.spec import Run, SimRun, Study
@@ -74,9 +74,9 @@ def _simulate(scenario: planner.Scenario, run: SimRun) -> tuple[dict, list]:
             "max_lateral_error_m": s["cross_track_error_m"]["max"]}, []
 
 
-def run_study(study: Study, out: Path, workers: int) -> Summary:
-    """Run what ``out`` does not hold yet. Ctrl-C stops the workers and raises
-    KeyboardInterrupt once every finished run is stored."""
+def run_study(study: Study, out: Path, workers: int, backend: str = "local") -> Summary:
+    """Run what ``out`` does not hold yet on ``backend`` (`backends.BACKENDS`). Ctrl-C stops
+    the workers and raises KeyboardInterrupt once every finished run is stored."""
     started = time.perf_counter()
     results = Results(out, study.name, study.kind, study.text)
     try:
@@ -87,7 +87,11 @@ def run_study(study: Study, out: Path, workers: int) -> Summary:
             print(f"{skipped} of {len(study.runs)} runs already in {results.path}: skipped",
                   file=sys.stderr)
         if todo:
-            _run_on_pool(study, todo, results, min(workers, len(todo)))
+            runner = open_backend(backend, min(workers, len(todo)))
+            try:
+                _run_on(runner, study, todo, results)
+            finally:
+                runner.close()
         stored, failed = results.count()
         results.write_csv(out / "results.csv")
     finally:
@@ -98,31 +102,28 @@ def run_study(study: Study, out: Path, workers: int) -> Summary:
                    str(report))
 
 
-def _run_on_pool(study: Study, todo: list, results: Results, workers: int) -> None:
+def _run_on(backend, study: Study, todo: list, results: Results) -> None:
     bar = tqdm(total=len(todo), desc=study.name, unit="run", file=sys.stderr,
                disable=not sys.stderr.isatty())
-    pool = start_pool(workers)
     pending: dict = {}
     queue = iter(todo)
     solved = 0
     try:
         while True:
-            while len(pending) < 2 * workers:  # a short queue: Ctrl-C cancels little work
+            while len(pending) < 2 * backend.workers:  # short: Ctrl-C cancels little work
                 run = next(queue, None)
                 if run is None:
                     break
-                pending[pool.submit(execute, study.scenarios[run.scenario], run)] = run
+                pending[backend.submit(execute, study.scenarios[run.scenario], run)] = run
             if not pending:
                 break
-            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-            for future in finished:
-                run = pending.pop(future)
-                outcome, curve = future.result()
+            for handle in backend.finished(pending):
+                run = pending.pop(handle)
+                outcome, curve = backend.result(handle)
                 results.add(run, outcome, curve)
                 solved += outcome.get("solved", outcome.get("reached", 0)) or 0
                 bar.update()
                 bar.set_postfix({"solved" if study.kind == "plan" else "reached": solved},
                                 refresh=False)
     finally:
-        stop_pool(pool)
         bar.close()
