@@ -27,6 +27,8 @@ from app.study.results import TABLES
 
 __all__ = ["write_report"]
 
+MAX_CURVES = 8  # cost curves per plot: more is spaghetti
+
 
 @dataclass(frozen=True)
 class Kind:
@@ -147,22 +149,31 @@ def _figures(db, kind: Kind, settings: dict[str, Setting]):
 
 
 def _cost_over_time(db, settings: dict[str, Setting]):
+    """One curve per setting at the largest budget: with a seed, a run of fewer iterations is
+    the start of the longer one, so its curve adds nothing."""
     from matplotlib.figure import Figure
 
     rows = [r for s in settings.values() for r in s.rows]
     by_time = all(r["budget_iterations"] is None for r in rows)
+    column = "budget_time_s" if by_time else "budget_iterations"
+    largest = max(r[column] or 0 for r in rows)
+    candidates = [s for s in settings.values() if s.rows[0][column] == largest]
+    shown = sorted(candidates, key=lambda s: _rank(KINDS["plan"], s))[:MAX_CURVES]
     end = max((r["budget_time_s"] if by_time else r["iterations"]) or 0 for r in rows)
     grid = np.linspace(0, end, 200)
-    fig = Figure(figsize=(8, 4.5), layout="constrained")
+    fig = Figure(figsize=(8, 4.5 + 0.2 * len(shown)), layout="constrained")
     ax = fig.subplots()
-    for i, (label, setting) in enumerate(settings.items()):
+    for i, setting in enumerate(shown):
         low, mid, high = _curve(db, setting, by_time, grid)
-        ax.plot(grid, mid, color=f"C{i % 10}", label=label)
-        ax.fill_between(grid, low, high, color=f"C{i % 10}", alpha=0.15)
+        ax.plot(grid, mid, color=f"C{i}", label=setting.label)
+        ax.fill_between(grid, low, high, color=f"C{i}", alpha=0.12)
     ax.set_xlabel("time (s)" if by_time else "iterations")
     ax.set_ylabel("best cost (m): median, quartiles\nover the seeds solved so far")
-    ax.legend(fontsize="small")
-    return "cost_over_time", "Cost over " + ("time" if by_time else "iterations"), fig
+    fig.legend(loc="outside lower center", fontsize="small")
+    title = "Cost over " + ("time" if by_time else "iterations")
+    if len(candidates) > len(shown):
+        title += f": the best {len(shown)} of {len(candidates)} settings"
+    return "cost_over_time", title, fig
 
 
 def _against_parameters(kind: Kind, settings: dict[str, Setting]):
@@ -181,31 +192,35 @@ def _against_parameters(kind: Kind, settings: dict[str, Setting]):
         rate_ax, value_ax = fig.subplots(1, 2)
         groups: dict[str, dict] = {}
         for row in rows:
-            value = json.loads(row["parameters"]).get(key)
-            if value is not None:
+            params = json.loads(row["parameters"])
+            if key in params:  # None, the default, is a value of its own
                 name = f"{row['planner']} {row['steering']}" if "planner" in row else "runs"
-                groups.setdefault(name, {}).setdefault(value, []).append(row)
+                groups.setdefault(name, {}).setdefault(params[key], []).append(row)
         for i, (name, by_value) in enumerate(groups.items()):
-            xs = sorted(by_value)
+            xs = sorted(by_value, key=lambda v: (0, v) if isinstance(v, int | float) else
+                        (1, str(v)))
             rate = [100 * np.mean([r[kind.success] or 0 for r in by_value[x]]) for x in xs]
             values = [np.median(v) if len(v := [r[column] for r in by_value[x]
                                                 if r[column] is not None]) else np.nan
                       for x in xs]
-            rate_ax.plot(xs, rate, "o-", color=f"C{i}", label=name)
-            value_ax.plot(xs, values, "o-", color=f"C{i}", label=name)
+            numeric = all(isinstance(x, int | float) and not isinstance(x, bool) for x in xs)
+            at = xs if numeric else [str(x) for x in xs]  # None (a default), names: categories
+            rate_ax.plot(at, rate, "o-", color=f"C{i}", label=name)
+            value_ax.plot(at, values, "o-", color=f"C{i}", label=name)
         rate_ax.set(xlabel=key, ylabel=f"{kind.success_label} (%)", ylim=(-5, 105))
         value_ax.set(xlabel=key, ylabel=label)
         value_ax.legend(fontsize="small")
         yield f"against_{key}", f"Against {key}", fig
 
 
-def _best(kind: Kind, settings: dict[str, Setting]) -> Setting:
-    """Highest success rate, then the lowest median of ``kind.best``."""
-    def rank(s: Setting):
-        tie = s.median(kind.best)
-        return (-s.rate(kind.success), tie if math.isfinite(tie) else math.inf)
+def _rank(kind: Kind, s: Setting) -> tuple:
+    """Highest success rate first, then the lowest median of ``kind.best``."""
+    tie = s.median(kind.best)
+    return (-s.rate(kind.success), tie if math.isfinite(tie) else math.inf)
 
-    return min(settings.values(), key=rank)
+
+def _best(kind: Kind, settings: dict[str, Setting]) -> Setting:
+    return min(settings.values(), key=lambda s: _rank(kind, s))
 
 
 def _slug(text: str) -> str:
