@@ -117,6 +117,14 @@ def _segment_distance(p: np.ndarray, q: np.ndarray) -> float:
                      _point_segment(b[..., 2], b[..., 3], a).min()))
 
 
+def _obstacles_at(scn: dict, t: float | None):
+    """(obstacle, dx, dy): each obstacle there at time t and its offset (None: static ones)."""
+    for ob in scn["obstacles"]:
+        if t is None and ob.get("motion"):
+            continue
+        yield (ob, *obstacle_offset(ob, t or 0.0))
+
+
 def _rectangle_valid(scn: dict, rect, x: float, y: float, theta: float,
                      t: float | None) -> bool:
     """The rectangle inside the bounds (touching them is fine, as for the disc) and apart from
@@ -127,10 +135,7 @@ def _rectangle_valid(scn: dict, rect, x: float, y: float, theta: float,
             and (corners[:, 1] >= ymin).all() and (corners[:, 1] <= ymax).all()):
         return False
     edges = np.hstack([corners, np.roll(corners, -1, axis=0)])
-    for ob in scn["obstacles"]:
-        if t is None and ob.get("motion"):
-            continue
-        dx, dy = obstacle_offset(ob, t or 0.0)
+    for ob, dx, dy in _obstacles_at(scn, t):
         if ob["type"] == "circle":
             cx, cy = ob["center"]
             if _rect_distance(x, y, theta, rect, cx + dx, cy + dy) <= ob["radius"]:
@@ -160,10 +165,7 @@ def pose_valid(scn: dict, x: float, y: float, t: float | None,
     xmin, ymin, xmax, ymax = scn["bounds"]
     if not (xmin + r <= x <= xmax - r and ymin + r <= y <= ymax - r):
         return False
-    for ob in scn["obstacles"]:
-        if t is None and ob.get("motion"):
-            continue
-        dx, dy = obstacle_offset(ob, t or 0.0)
+    for ob, dx, dy in _obstacles_at(scn, t):
         if ob["type"] == "circle":
             cx, cy = ob["center"]
             if math.hypot(x - cx - dx, y - cy - dy) <= ob["radius"] + r:
