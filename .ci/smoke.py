@@ -3,8 +3,8 @@
 Run with the fresh venv's Python. Starts `trackstar serve` on free loopback ports with a
 temporary data dir, probes /health, the studio page, /docs (with its assets served locally),
 the bundled scenarios and one plan over REST, then stops it with SIGTERM and checks that it and
-its workers are gone within 10 s. Then, in an empty directory, `trackstar scenario list` and
-`trackstar plan slalom`. Only the standard library is used here, so a module missing from the
+its workers are gone within 10 s. Then, in an empty directory, `trackstar scenario list`,
+`trackstar plan slalom` and a one-run `trackstar study`. Only the standard library is used here, so a module missing from the
 runtime dependencies fails in the app, not in this script.
 """
 
@@ -107,6 +107,13 @@ def cli(workdir: Path) -> None:
                          cwd=empty, capture_output=True, text=True, timeout=600)
     check(run.returncode == 0 and json.loads(run.stdout)["solved"],
           f"trackstar plan slalom solves in an empty directory {run.stderr.strip()}")
+    (empty / "tiny.yaml").write_text("name: tiny\nscenarios: [slalom]\nplanners: [rrt]\n"
+                                     "budget: {iterations: 200}\n")
+    run = subprocess.run([BIN / "trackstar", "study", "tiny.yaml", "--json"], cwd=empty,
+                         capture_output=True, text=True, timeout=600)
+    report = empty / "studies" / "tiny" / "report.html"
+    check(run.returncode == 0 and json.loads(run.stdout)["done"] == 1 and report.is_file(),
+          f"trackstar study runs a study and writes its report {run.stderr.strip()[-300:]}")
 
 
 if __name__ == "__main__":
