@@ -95,7 +95,7 @@ def test_delete_stops_a_study_and_keeps_its_finished_runs(server):
 
 def test_a_restarted_server_resumes_an_interrupted_study(tmp_path):
     srv = Server(tmp_path)
-    body = dict(STUDY, name="resumed", planners=["rrtstar"], parameters={}, seeds=24,
+    body = dict(STUDY, name="resumed", planners=["rrtstar"], parameters={}, seeds=40,
                 budget={"iterations": 5000})
     study_id = srv.client.post("/studies", json=body).json()["id"]
     deadline = time.monotonic() + 30
@@ -106,9 +106,9 @@ def test_a_restarted_server_resumes_an_interrupted_study(tmp_path):
     again = Server(tmp_path)
     try:
         status = wait(again, study_id, timeout=120)
-        assert status["status"] == "done" and status["done"] == 24
-        assert 3 <= status["skipped"] < 24  # the runs stored before the stop were not redone
+        assert status["status"] == "done" and status["done"] == 40
+        assert 3 <= status["skipped"] < 40  # the runs stored before the stop were not redone
         rows = again.client.get(f"/studies/{study_id}/results.csv").text.strip().splitlines()
-        assert len(rows) == 25  # a header and each run once
+        assert len(rows) == 41  # a header and each run once
     finally:
         again.stop()
