@@ -18,6 +18,7 @@ from pydantic import BaseModel
 
 import planner
 import tracks
+from app.server.routes_jobs import MAX_RUNS
 from app.server.routes_scenarios import stored_scenario
 from app.study.report import write_report
 from app.study.results import TABLES, runs_csv
@@ -25,7 +26,6 @@ from app.study.spec import Study, StudyError, parse_study
 
 router = APIRouter(tags=["studies"])
 
-MAX_RUNS = 10_000
 EXAMPLE = {"name": "eps", "scenarios": ["slalom"], "planners": ["rrt", "rrtstar"],
            "parameters": {"eps": [1.0, 2.0]}, "seeds": 3, "budget": {"iterations": 1000}}
 

@@ -1,4 +1,5 @@
-"""Run a study's remaining runs on a process pool, storing each the moment it finishes."""
+"""Run a study's remaining runs on a backend (this machine's pool or Ray), storing each the
+moment it finishes, then write its table and report."""
 
 from __future__ import annotations
 
@@ -33,7 +34,7 @@ class Summary:
     wall_s: float
     results: str
     csv: str
-    report: str | None
+    report: str
 
 
 def execute(scenario: planner.Scenario, run: Run | SimRun,
