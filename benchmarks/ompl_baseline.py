@@ -1,8 +1,9 @@
 """OMPL baseline for the planner benchmark: one (scenario, planner, time limit, seed) run.
 
-The problem is set up the way the shared scenarios' FORMAT.md defines it: Dubins steering, a
-pure-Python pose validity checker with FORMAT.md's exact semantics, motions checked every 0.02 m, a
-goal region with position and heading tolerances, path length as the objective.
+The problem is set up by `planner.ompl_bridge` the way the shared scenarios' FORMAT.md defines it
+(Dubins steering, motions checked every 0.02 m, a goal region with position and heading
+tolerances, path length as the objective); pose validity here is a pure-Python checker with
+FORMAT.md's exact semantics, so that this baseline does not depend on our compiled world.
 
 OMPL's random seed is process-wide and takes effect only before the first random number is drawn, so
 each run needs a fresh process: `run_ompl_isolated` (used by bench_planner.py) starts one; run as a
@@ -18,24 +19,14 @@ import json
 import math
 import subprocess
 import sys
-import time
 from collections.abc import Callable
 from pathlib import Path
 
-from ompl import base as ob
-from ompl import geometric as og
-from ompl import util as ou
+from planner.ompl_bridge import OMPL_PLANNERS, OmplSetup, plan
 
 __all__ = ["PLANNERS", "run_ompl", "run_ompl_isolated", "make_pose_checker", "turning_radius"]
 
-PLANNERS: dict[str, Callable[[ob.SpaceInformation], ob.Planner]] = {
-    "RRT": og.RRT,
-    "RRTstar": og.RRTstar,
-    "InformedRRTstar": og.InformedRRTstar,
-    "BITstar": og.BITstar,
-}
-CHECK_STEP_M = 0.02  # OMPL's motion-check resolution, as FORMAT.md asks for comparisons
-RECHECK_STEP_M = 0.005  # re-check of the returned path, to count clipped obstacle corners
+PLANNERS = sorted(OMPL_PLANNERS.values())
 
 
 def turning_radius(vehicle: dict) -> float:
@@ -118,150 +109,21 @@ def _near_edge(x: float, y: float, edges: list, r2: float) -> bool:
     return False
 
 
-def _wrap(angle: float) -> float:
-    """Angle wrapped to [-pi, pi)."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
-
-
-class PoseGoal(ob.GoalSampleableRegion):
-    """FORMAT.md's goal: within `position` metres and `heading` radians of the goal pose.
-
-    distanceGoal is <= 0 exactly inside the region (threshold 0), so OMPL's isSatisfied means what
-    FORMAT.md means. The only goal sample is the exact goal pose: that is the goal bias of RRT*,
-    and BIT* (which reaches the goal only through goal samples) ends its paths there.
-    """
-
-    def __init__(self, si: ob.SpaceInformation, pose: list[float], tolerance: dict) -> None:
-        super().__init__(si)
-        self.setThreshold(0.0)
-        self._x, self._y, self._theta = (float(v) for v in pose)
-        self._position = float(tolerance.get("position", 0.25))
-        self._heading = math.radians(tolerance.get("heading_deg", 20.0))
-
-    def distanceGoal(self, state: ob.State) -> float:
-        off_position = math.hypot(state.getX() - self._x, state.getY() - self._y) - self._position
-        off_heading = abs(_wrap(state.getYaw() - self._theta)) - self._heading
-        return max(off_position, off_heading)
-
-    def sampleGoal(self, state: ob.State) -> None:
-        state.setX(self._x)
-        state.setY(self._y)
-        state.setYaw(self._theta)
-
-    def maxSampleCount(self) -> int:
-        return 1
-
-
-def _build_problem(scenario: dict, is_free: Callable[[float, float], bool]
-                   ) -> tuple[ob.DubinsStateSpace, ob.SpaceInformation, ob.ProblemDefinition]:
-    """Dubins space over the scenario bounds, the pose checker, start, goal region, path length."""
-    space = ob.DubinsStateSpace(turning_radius(scenario["vehicle"]))
-    bounds = ob.RealVectorBounds(2)
-    xmin, ymin, xmax, ymax = scenario["bounds"]
-    bounds.setLow(0, xmin)
-    bounds.setLow(1, ymin)
-    bounds.setHigh(0, xmax)
-    bounds.setHigh(1, ymax)
-    space.setBounds(bounds)
-
-    si = ob.SpaceInformation(space)
-    si.setStateValidityChecker(lambda state: is_free(state.getX(), state.getY()))
-    si.setStateValidityCheckingResolution(CHECK_STEP_M / space.getMaximumExtent())
-    si.setup()
-
-    pdef = ob.ProblemDefinition(si)
-    pdef.addStartState(_state(space, scenario["start"]))
-    pdef.setGoal(PoseGoal(si, scenario["goal"], scenario.get("goal_tolerance", {})))
-    objective = ob.PathLengthOptimizationObjective(si)
-    objective.setCostThreshold(ob.Cost(0.0))  # never "good enough": optimise for the whole budget
-    pdef.setOptimizationObjective(objective)
-    return space, si, pdef
-
-
-def _state(space: ob.DubinsStateSpace, pose: list[float]) -> ob.State:
-    state = space.allocState()
-    state.setX(float(pose[0]))
-    state.setY(float(pose[1]))
-    state.setYaw(float(pose[2]))
-    return state
-
-
-def _solve_timed(planner: ob.Planner, time_limit: float) -> tuple[float, float | None]:
-    """Plan until the time limit; return (elapsed s, time to first solution s or None).
-
-    The 2.0.1 bindings cannot take a Python intermediate-solution callback, and RRT* publishes its
-    solution to the problem definition only when it returns, so the first solution is seen by a
-    Python termination condition, which OMPL evaluates once per iteration: it polls bestCost().
-    RRT has no bestCost(), but it stops at its first solution.
-    """
-    has_best_cost = hasattr(planner, "bestCost")
-    first: list[float] = []
-    start = time.perf_counter()
-    deadline = start + time_limit
-
-    def done() -> bool:
-        now = time.perf_counter()
-        if has_best_cost and not first and math.isfinite(planner.bestCost().value()):
-            first.append(now - start)
-        return now >= deadline
-
-    planner.solve(ob.PlannerTerminationCondition(done))
-    elapsed = time.perf_counter() - start
-    if not first and planner.getProblemDefinition().hasExactSolution():
-        first.append(elapsed)
-    return elapsed, (first[0] if first else None)
-
-
-def _path_valid(space: ob.DubinsStateSpace, path: og.PathGeometric,
-                is_free: Callable[[float, float], bool], step: float) -> bool:
-    """Re-check every pose of the path `step` metres apart (OMPL itself checked every 0.02 m)."""
-    pose = space.allocState()
-    states = [path.getState(i) for i in range(path.getStateCount())]
-    for a, b in zip(states, states[1:]):
-        n = max(1, math.ceil(space.distance(a, b) / step))
-        for i in range(n + 1):
-            space.interpolate(a, b, i / n, pose)
-            if not is_free(pose.getX(), pose.getY()):
-                return False
-    return True
+def ompl_setup(scenario: dict) -> OmplSetup:
+    """A FORMAT.md scenario as the bridge's set-up, checked by the pure-Python checker."""
+    is_free = make_pose_checker(scenario)
+    tolerance = scenario.get("goal_tolerance", {})
+    return OmplSetup(tuple(scenario["bounds"]), tuple(scenario["start"]), tuple(scenario["goal"]),
+                     float(tolerance.get("position", 0.25)),
+                     math.radians(tolerance.get("heading_deg", 20.0)),
+                     turning_radius(scenario["vehicle"]), lambda x, y, _theta: is_free(x, y))
 
 
 def run_ompl(scenario: dict, planner: str, time_limit: float, seed: int) -> dict:
-    """Plan one scenario with one OMPL planner; seeds are honoured once per process only.
-
-    OMPL refuses seed 0, so OMPL's seed is `seed + 1` (seeds 0 and 1 would otherwise coincide).
-
-    `iterations` is the planner's own count (RRT* loop iterations, BIT* queue iterations; None for
-    RRT, which has no counter). `nodes` counts tree vertices as edges + 1, because BIT*'s planner
-    data also lists its unconnected samples. Cost is the Dubins length of an exact solution.
-    """
-    ou.setLogLevel(ou.LOG_ERROR)
-    ou.RNG.setSeed(seed + 1)
-    is_free = make_pose_checker(scenario)
-    space, si, pdef = _build_problem(scenario, is_free)
-    algorithm = PLANNERS[planner](si)
-    algorithm.setProblemDefinition(pdef)
-    algorithm.setup()
-
-    elapsed, first_s = _solve_timed(algorithm, time_limit)
-    solved = pdef.hasExactSolution()
-    path = pdef.getSolutionPath() if solved else None
-    iterations = algorithm.numIterations() if hasattr(algorithm, "numIterations") else None
-    data = ob.PlannerData(si)
-    algorithm.getPlannerData(data)
-    return {
-        "scenario": scenario["name"],
-        "planner": planner,
-        "time_limit_s": time_limit,
-        "seed": seed,
-        "solved": solved,
-        "cost": path.length() if solved else None,
-        "time_to_first_solution_s": first_s,
-        "iterations": iterations,
-        "iterations_per_s": iterations / elapsed if iterations is not None else None,
-        "nodes": data.numEdges() + 1,
-        "valid_5mm": _path_valid(space, path, is_free, RECHECK_STEP_M) if solved else None,
-    }
+    """Plan one scenario with one OMPL planner (`planner.ompl_bridge.plan`); the seed is
+    honoured once per process only."""
+    result = plan(ompl_setup(scenario), planner, seed=seed, time_limit=time_limit)
+    return {"scenario": scenario["name"], **result}
 
 
 def run_ompl_isolated(scenario: dict, planner: str, time_limit: float, seed: int) -> dict:

@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
+from numba import float64, typeof
 
 from planner._world import RADIUS, World, build_world, pose_clearance
 from planner.scenario import Box, Circle, Scenario, ScenarioError
@@ -47,7 +49,19 @@ class Problem:
     def clearance(self, x: float, y: float, t: float = 0.0, theta: float = 0.0) -> float:
         """Signed clearance of the car's footprint at pose (x, y, theta) at time t (NaN: static
         obstacles only)."""
-        return float(pose_clearance(self.world, x, y, theta, t))
+        return float(self._pose_clearance(self.world, x, y, theta, t))
+
+    @cached_property
+    def _pose_clearance(self):
+        """`pose_clearance` compiled for this world's types, called past numba's dispatcher:
+        typing a record of 17 arrays costs ~15 µs on every call, the compiled entry ~2 µs,
+        which matters to callers that check pose by pose (OMPL's validity checker)."""
+        pose_clearance(self.world, 0.0, 0.0, 0.0, math.nan)  # compiles (or loads) it
+        return pose_clearance.overloads[(typeof(self.world),) + (float64,) * 4].entry_point
+
+    def __getstate__(self) -> dict:
+        """Pickled without the compiled entry point (a process compiles or loads its own)."""
+        return {k: v for k, v in self.__dict__.items() if k != "_pose_clearance"}
 
 
 def resolve_track(scenario: Scenario, load_track=None):

@@ -10,6 +10,7 @@ import sqlite3
 import subprocess
 import time
 
+import numpy as np
 import pytest
 
 STUDY = """\
@@ -154,6 +155,10 @@ def test_ctrl_c_keeps_finished_runs_and_the_next_invocation_goes_on(study_file, 
     (STUDY.replace("name: small", "name: a b"), "name"),
     (STUDY.replace("budget:", "budget: ["), "not valid YAML"),
     ("- just\n- a list\n", "a study is a mapping"),
+    (STUDY.replace("[rrt, rrtstar]", "[rrt, ompl:bitstar]") + "steering: [straight]\n",
+     "steering: ompl:bitstar plans dubins or reeds-shepp only, not 'straight'"),
+    (STUDY.replace("[rrt, rrtstar]", "[ompl:rrtstar]").replace("open_field", "crossing"),
+     "scenarios[0] (crossing): has moving obstacles, which OMPL's planners cannot plan"),
 ])
 def test_a_bad_study_file_is_refused_naming_the_key(study_file, body, words):
     from app.study.spec import StudyError, load_study
@@ -279,3 +284,63 @@ def test_without_ray_the_ray_backend_says_how_to_install_it(study_file, tmp_path
                          timeout=60)
     assert out.returncode == 2 and "pip install 'trackstar[ray]'" in out.stderr
     assert len(out.stderr.strip().splitlines()) == 1
+
+
+OMPL_STUDY = """\
+name: side-by-side
+scenarios: [slalom]
+planners: [rrtstar, ompl:rrtstar, ompl:bitstar]
+parameters:
+  eps: [1.0]
+  informed: [false]
+seeds: [3]
+budget:
+  iterations: 600
+"""
+
+
+def test_ompl_planners_run_beside_ours_on_the_same_free_space(tmp_path):
+    pytest.importorskip("ompl")
+    from conftest import scenario_dict
+
+    from planner.ompl_bridge import plan_isolated
+
+    study = tmp_path / "side.yaml"
+    study.write_text(OMPL_STUDY)
+    out = trackstar("study", str(study), "--out", str(tmp_path / "out"), "--json")
+    assert out.returncode == 0, out.stderr
+    columns = ("planner", "parameters", "solved", "cost", "iterations", "nodes",
+               "collision_checks", "min_clearance_m", "id")
+    by_planner = {r[0]: r for r in rows(tmp_path / "out", columns)}
+    # Each planner keeps the parameters it has: OMPL's RRT* its range, BIT* none.
+    assert {p: json.loads(r[1]) for p, r in by_planner.items()} == {
+        "rrtstar": {"eps": 1.0, "informed": False}, "ompl:rrtstar": {"eps": 1.0}, "ompl:bitstar": {}}
+    assert by_planner["ompl:rrtstar"][4] == 600  # OMPL's own iteration count, as budgeted
+    _, _, solved, cost, _, nodes, checks, clearance, run_id = by_planner["ompl:bitstar"]
+    assert solved == 1 and checks is None  # OMPL counts no exact motion checks of ours
+    assert clearance > 0  # its path, re-checked every 5 mm against our world
+    straight = np.hypot(*np.subtract(scenario_dict("slalom")["goal"][:2],
+                                     scenario_dict("slalom")["start"][:2]))
+    assert straight < cost < 2 * straight
+    with sqlite3.connect(tmp_path / "out" / "results.sqlite") as db:
+        curve = [c for (c,) in db.execute("SELECT cost FROM cost_over_time WHERE run_id = ? "
+                                          "ORDER BY iteration", (run_id,))]
+    assert curve[-1] == cost and curve == sorted(curve, reverse=True)
+    # With an iteration budget OMPL's run is reproducible: the row is a direct run's.
+    again = plan_isolated(scenario_dict("slalom"), "BITstar", seed=3, iterations=600)
+    assert (again["cost"], again["nodes"]) == (cost, nodes)
+    assert "ompl:bitstar" in (tmp_path / "out" / "report.html").read_text()
+
+
+def test_without_ompl_its_planners_say_how_to_install_it(tmp_path):
+    fake = tmp_path / "no_ompl" / "ompl"
+    fake.mkdir(parents=True)
+    (fake / "__init__.py").write_text("raise ImportError('no ompl here')\n")
+    study = tmp_path / "side.yaml"
+    study.write_text(OMPL_STUDY)
+    env = {**__import__("os").environ, "PYTHONPATH": str(fake.parent)}
+    out = subprocess.run(["trackstar", "study", str(study), "--out", str(tmp_path / "o")],
+                         capture_output=True, text=True, env=env, timeout=60)
+    assert out.returncode == 2 and not (tmp_path / "o").exists()
+    assert out.stderr.strip().splitlines() == [
+        f"error: {study}: planners: ompl:rrtstar needs OMPL: pip install 'trackstar[bench]'"]

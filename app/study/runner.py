@@ -17,6 +17,7 @@ from app.study.backends import open_backend
 from app.study.report import write_report
 from app.study.results import Results
 from app.study.spec import Run, SimRun, Study
+from planner.ompl_bridge import OMPL_PLANNERS, plan_isolated
 
 __all__ = ["Summary", "execute", "run_study"]
 
@@ -52,6 +53,8 @@ def execute(scenario: planner.Scenario, run: Run | SimRun,
 
 
 def _plan(scenario: planner.Scenario, run: Run, max_time: float | None) -> tuple[dict, list]:
+    if run.planner in OMPL_PLANNERS:
+        return _plan_ompl(scenario, run, max_time)
     report = run_plan(scenario, run.options(), max_time=max_time)
     rate = report.iterations / report.planning_time_s if report.planning_time_s > 0 else None
     outcome = {
@@ -61,6 +64,20 @@ def _plan(scenario: planner.Scenario, run: Run, max_time: float | None) -> tuple
         "collision_checks": report.collision_checks, "min_clearance_m": report.min_clearance_m,
         "iterations_per_s": rate}
     return outcome, [(i, t, cost) for t, cost, i in report.cost_over_time]
+
+
+def _plan_ompl(scenario: planner.Scenario, run: Run,
+               max_time: float | None) -> tuple[dict, list]:
+    """OMPL's planner in a fresh process (its seed is process-wide), on our world's free space.
+    It counts no motion checks of ours, so ``collision_checks`` stays empty."""
+    limits = [t for t in (run.budget_time_s, max_time) if t is not None]
+    r = plan_isolated(scenario.model_dump(mode="json"), OMPL_PLANNERS[run.planner],
+                      steering=run.steering, seed=run.seed, iterations=run.budget_iterations,
+                      time_limit=min(limits) if limits else None, **run.parameters)
+    outcome = {"solved": int(r["solved"]), "collision_checks": None} | {
+        k: r[k] for k in ("cost", "time_to_first_solution_s", "iterations", "nodes",
+                          "min_clearance_m", "iterations_per_s")}
+    return outcome, [tuple(point) for point in r["cost_over_time"]]
 
 
 def _simulate(scenario: planner.Scenario, run: SimRun) -> tuple[dict, list]:

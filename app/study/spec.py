@@ -3,7 +3,8 @@
 A planning run is one (scenario, planner, steering, parameter point, budget, seed), a driven run
 (``kind: simulate``) one (scenario, parameter point, seed); the key identifies a run in the
 results, so a resumed or extended study redoes nothing. A parameter that a planner does not have
-(RRT has no γ, k or informed sampling) is dropped from its points, so such a planner runs once
+(RRT has no γ, k or informed sampling; OMPL's take only eps and goal_bias) is dropped from its
+points, so such a planner runs once
 per point of the parameters it has.
 """
 
@@ -22,6 +23,8 @@ from pydantic import Field, ValidationError, ValidationInfo, field_validator, mo
 
 import planner
 from app.simulation import SimOptions
+from planner import ompl_bridge
+from planner.ompl_bridge import OMPL_PARAMETERS, OMPL_PLANNERS, STEERING_SPACES
 from planner.options import PLANNERS, PlanOptions, PositiveFinite, Seed
 from planner.steering import STEERINGS, SteeringName
 from planner.validation import StrictModel, describe, suggest
@@ -34,6 +37,7 @@ __all__ = ["PARAMETERS", "SIM_PARAMETERS", "Run", "SimRun", "Study", "StudyError
 PARAMETERS = ("eps", "gamma", "k_rrt", "goal_bias", "informed", "metric", "speed")
 SIM_PARAMETERS = tuple(k for k in SimOptions.model_fields if k != "seed")
 _RRTSTAR_ONLY = ("gamma", "k_rrt", "informed")
+TARGETS = (*PLANNERS, *OMPL_PLANNERS)  # ours, and OMPL's with the bench extra
 
 Count = Annotated[int, Field(ge=1)]
 
@@ -103,7 +107,7 @@ class StudyFile(StrictModel):
     description: str | None = None
     kind: Literal["plan", "simulate"] = "plan"
     scenarios: Annotated[list[str | dict[str, Any]], Field(min_length=1)]
-    planners: Annotated[list[Literal[PLANNERS]], Field(min_length=1)] | None = None
+    planners: Annotated[list[Literal[TARGETS]], Field(min_length=1)] | None = None
     steering: Annotated[list[SteeringName], Field(min_length=1)] | None = None
     parameters: dict[str, Annotated[list[Any], Field(min_length=1)] | Range] = Field(
         default_factory=dict)
@@ -178,6 +182,18 @@ class StudyFile(StrictModel):
                 if getattr(self, key) is not None:
                     raise ValueError(f"{key}: a simulate study replans as trackstar simulate "
                                      f"does; leave it out")
+        return self
+
+    @model_validator(mode="after")
+    def _ompl_can_run(self) -> StudyFile:
+        """OMPL's targets need the bench extra, and plan Dubins or Reeds-Shepp only."""
+        ompl = [p for p in self.planners or () if p in OMPL_PLANNERS]
+        if ompl and not ompl_bridge.available():
+            raise ValueError(f"planners: {ompl[0]} needs OMPL: pip install 'trackstar[bench]'")
+        other = [s for s in self.steering or () if s not in STEERING_SPACES]
+        if ompl and other:
+            raise ValueError(f"steering: {ompl[0]} plans {' or '.join(STEERING_SPACES)} only, "
+                             f"not '{other[0]}'")
         return self
 
     @model_validator(mode="after")
@@ -261,6 +277,9 @@ class Study:
 
 def _has(planner_name: str, point: dict) -> dict:
     """The part of a parameter point that ``planner_name`` has."""
+    if planner_name in OMPL_PLANNERS:
+        return {k: v for k, v in point.items()
+                if k in OMPL_PARAMETERS[OMPL_PLANNERS[planner_name]]}
     return {k: v for k, v in point.items()
             if planner_name == "rrtstar" or k not in _RRTSTAR_ONLY}
 
@@ -284,6 +303,10 @@ def parse_study(data: Any, text: str, resolve: Callable[[Any], planner.Scenario]
         except planner.ScenarioError as exc:
             shown = f" ({source})" if isinstance(source, str) else ""
             raise StudyError(f"{lead}scenarios[{i}]{shown}: {exc}") from None
+        if scenario.has_motion and any(p in OMPL_PLANNERS for p in spec.planners or ()):
+            raise StudyError(f"{lead}scenarios[{i}] ({scenario.name}): has moving obstacles, "
+                             f"which OMPL's planners cannot plan; leave out the ompl: "
+                             f"planners or this scenario")
         scenarios.setdefault(scenario.name, scenario)
     return Study(spec.name, spec.kind, text, scenarios, _runs(spec, list(scenarios)))
 
