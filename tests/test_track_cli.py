@@ -30,7 +30,8 @@ def test_inspect_json_lists_every_rendered_path_with_its_measures():
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert set(report) == {"unit_m", "paths"}
-    keys = {"id", "label", "closed", "length_m", "length_user", "bbox_m", "width_m"}
+    keys = {"selector", "id", "label", "subpath", "closed", "length_m", "length_user", "bbox_m",
+            "width_m"}
     assert all(set(p) == keys and len(p["bbox_m"]) == 4 for p in report["paths"])
     assert [p["id"] for p in report["paths"]][:2] == ["arcpath", "mirror"]
 

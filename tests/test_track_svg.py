@@ -197,7 +197,7 @@ def test_choice_by_id_then_label_else_the_longest_path():
     assert load_svg(doc, path_id="Long").length_m == pytest.approx(0.04)
     assert load_svg(doc, path_id="Short").length_m == pytest.approx(0.02)  # an id wins over a label
     assert load_svg(doc, path_id="a", width_m=0.7).width_m == 0.7
-    with pytest.raises(TrackError, match="no path with id or label 'zz'; available: Short, a, b"):
+    with pytest.raises(TrackError, match="no path with id or label 'zz'; available: a, b, Short"):
         load_svg(doc, path_id="zz")
 
 

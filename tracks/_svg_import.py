@@ -18,8 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import defusedxml
-import defusedxml.ElementTree as SafeET
 import numpy as np
+from defusedxml.ElementTree import DefusedXMLParser
 
 from tracks._errors import TrackError
 from tracks._segments import Bezier, Segment, arc_from_endpoints, line
@@ -33,6 +33,7 @@ XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
 INKSCAPE_LABEL = "{http://www.inkscape.org/namespaces/inkscape}label"
 _CONTAINERS = frozenset({"g", "svg", "a", "switch"})
 _MAX_ELEMENTS = 20_000
+DEFAULT_WIDTH_M = 0.5  # a track drawn with a zero stroke width (a hairline) gets this width
 _MAX_USE_DEPTH = 32
 # Per document: each segment costs ~0.15 ms to measure, and one takes 1 to 7 numbers, so this
 # bounds a load to a few seconds (counted without parsing, so small files stay fast).
@@ -46,6 +47,7 @@ Source = str | os.PathLike | bytes
 class _Element:
     """A rendered path-like element before its path data is parsed."""
 
+    tag: str
     id: str | None
     label: str | None
     path_data: str
@@ -53,7 +55,7 @@ class _Element:
     stroke_width: float  # local user units
 
 
-def _read(source: Source) -> tuple[bytes, str]:
+def read_source(source: Source) -> tuple[bytes, str]:
     if isinstance(source, bytes | bytearray):
         return bytes(source), "<bytes>"
     path = Path(source)
@@ -63,11 +65,23 @@ def _read(source: Source) -> tuple[bytes, str]:
         raise TrackError(f"cannot read {path}: {exc.strerror or exc}") from None
 
 
+class _SafeParser(DefusedXMLParser):
+    """defusedxml with a bare DOCTYPE allowed: editors write the W3C SVG 1.1 declaration, which
+    names an external DTD that expat never loads; an internal subset (where entities would be
+    declared) is still refused, as are entity declarations and external references."""
+
+    def defused_start_doctype_decl(self, name, sysid, pubid, has_internal_subset):
+        if has_internal_subset:
+            super().defused_start_doctype_decl(name, sysid, pubid, has_internal_subset)
+
+
 def parse_document(source: Source) -> ET.Element:
-    """The root <svg> element, parsed without DTDs, entities or external references."""
-    data, name = _read(source)
+    """The root <svg> element, parsed without DTD subsets, entities or external references."""
+    data, name = read_source(source)
     try:
-        root = SafeET.fromstring(data, forbid_dtd=True)
+        parser = _SafeParser(target=ET.TreeBuilder(), forbid_dtd=True)
+        parser.feed(data)
+        root = parser.close()
     except defusedxml.DefusedXmlException as exc:
         raise TrackError(f"{name}: unsafe XML refused ({type(exc).__name__})") from None
     except ET.ParseError as exc:
@@ -136,6 +150,7 @@ class _Walker:
         named = clone if clone is not None else elem
         self.found.append(
             _Element(
+                tag=tag,
                 id=named.attrib.get("id"),
                 label=named.attrib.get(INKSCAPE_LABEL) or elem.attrib.get(INKSCAPE_LABEL),
                 path_data=data,
@@ -194,43 +209,93 @@ def _segments(elem: _Element) -> list[list[Segment]]:
     return subpaths
 
 
-def element_track(elem: _Element, unit_m: float) -> Track | None:
-    """The element's longest subpath as a track in metres, world frame; None if it has none."""
+@dataclass(frozen=True)
+class _Entry:
+    """A listed element: its selector, its subpaths as tracks (None: zero length) and width."""
+
+    selector: str
+    elem: _Element
+    subpaths: list[Track | None]
+    width_m: float | None  # None: the stroke width is zero or invalid
+
+    @property
+    def track(self) -> Track:
+        """What selecting the element gives: its longest subpath."""
+        return max((t for t in self.subpaths if t is not None), key=lambda t: t.length_m)
+
+
+def _subpath_tracks(elem: _Element, unit_m: float, name: str, width_m: float) -> list:
+    """The element's subpaths as tracks in metres, world frame (None where of zero length)."""
     world = np.diag([unit_m, -unit_m, 1.0]) @ elem.matrix
     linear, offset = world[:2, :2], world[:2, 2]
-    width = elem.stroke_width * math.sqrt(abs(np.linalg.det(linear)))
-    if not width > 0:
-        raise TrackError(f"element {elem.id!r}: stroke width must be positive, got {width}")
-    best = None
+    out: list[Track | None] = []
     for sub in _segments(elem):
         segs = tuple(seg.transformed(linear, offset) for seg in sub)
-        if not segs:
-            continue
-        gap = np.hypot(*(segs[-1].end - segs[0].start))
+        gap = np.hypot(*(segs[-1].end - segs[0].start)) if segs else 0.0
         extent = max(
             np.ptp(np.array([s.start for s in segs] + [segs[-1].end]), axis=0).max(), 1e-300
-        )
+        ) if segs else 0.0
         try:
-            track = Track(
-                name=elem.id or elem.label or "track",
-                closed=bool(gap <= 1e-9 * extent),
-                width_m=width,
-                segments=segs,
-            )
+            out.append(Track(name=name, closed=bool(gap <= 1e-9 * extent), width_m=width_m,
+                             segments=segs))
         except TrackError:
-            continue
-        if best is None or track.length_m > best.length_m:
-            best = track
-    return best
+            out.append(None)
+    return out
 
 
-def _choose(elements: list[_Element], path_id: str) -> _Element:
-    for key in ("id", "label"):
-        for elem in elements:
-            if getattr(elem, key) == path_id:
-                return elem
-    names = sorted({e.id or e.label for e in elements if e.id or e.label})
-    shown = ", ".join(names[:12]) + (", …" if len(names) > 12 else "")
+def _selectors(elements: list[_Element]) -> list[str]:
+    """A name per element, unique in the document: its id, else its label, else ``TAG-K``
+    (the K-th rendered path-like element, from 1, e.g. ``path-3``), so that id-less drawings
+    can be chosen too. Cheap: no path data is parsed."""
+    ids = {e.id for e in elements if e.id}
+    names: list[str] = []
+    for k, elem in enumerate(elements, start=1):
+        label = elem.label if elem.label not in ids else None  # never another element's id
+        names.append(next((n for n in (elem.id, label, f"{elem.tag}-{k}")
+                           if n and n not in names), f"#{k}"))
+    return names
+
+
+def _entry(elem: _Element, selector: str, unit_m: float) -> _Entry | None:
+    """The element measured; None if no subpath has positive length."""
+    det = abs(np.linalg.det(elem.matrix[:2, :2])) * unit_m**2
+    width = elem.stroke_width * math.sqrt(det)
+    width = width if math.isfinite(width) and width > 0 else None
+    subpaths = _subpath_tracks(elem, unit_m, selector, width or DEFAULT_WIDTH_M)
+    return _Entry(selector, elem, subpaths, width) if any(subpaths) else None
+
+
+def _entries(elements: list[_Element], unit_m: float) -> list[_Entry]:
+    """Every element with a subpath of positive length, in document order."""
+    found = (_entry(e, n, unit_m) for e, n in zip(elements, _selectors(elements)))
+    return [entry for entry in found if entry is not None]
+
+
+_SUBPATH = re.compile(r"(.*):(\d+)")
+
+
+def _choose(elements: list[_Element], unit_m: float, path_id: str) -> Track:
+    """The track a selector names: an element's selector, id or label (its longest subpath),
+    or ``NAME:K`` for its K-th subpath (from 0). Only the chosen element is parsed."""
+    named = list(zip(elements, _selectors(elements)))
+    match = _SUBPATH.fullmatch(path_id)
+    keys = [(path_id, None)] + ([(match.group(1), int(match.group(2)))] if match else [])
+    for name, k in keys:
+        for lookup in (lambda e, n: n, lambda e, n: e.id, lambda e, n: e.label):
+            elem, selector = next(((e, n) for e, n in named if lookup(e, n) == name),
+                                  (None, None))
+            if elem is None:
+                continue
+            entry = _entry(elem, selector, unit_m)
+            if entry is None:
+                raise TrackError(f"path {path_id!r} has zero length")
+            if k is None:
+                return entry.track
+            if k < len(entry.subpaths) and entry.subpaths[k] is not None:
+                return entry.subpaths[k]
+            raise TrackError(f"path {name!r} has no subpath {k} of positive length "
+                             f"(it has {len(entry.subpaths)} subpaths, from 0)")
+    shown = ", ".join(n for _, n in named[:12]) + (", …" if len(named) > 12 else "")
     raise TrackError(f"no path with id or label {path_id!r}; available: {shown or 'none'}")
 
 
@@ -241,47 +306,49 @@ def load_svg(
     unit: str | None = None,
     width_m: float | None = None,
 ) -> Track:
-    """The track drawn in an SVG: the element with id or inkscape:label ``path_id``, else the
-    longest path. ``unit`` states what one user unit measures (default: from the document);
-    ``width_m`` overrides the track width (default: the transformed stroke width).
+    """The track drawn in an SVG: the element that ``path_id`` selects (see `inspect_svg`),
+    else the longest path. ``unit`` states what one user unit measures (default: from the
+    document); ``width_m`` overrides the track width (default: the transformed stroke width,
+    `DEFAULT_WIDTH_M` where that is zero).
     """
     root = parse_document(path_or_bytes)
     unit_m = document_unit_m(root.attrib, unit)
     elements = collect_elements(root)
     if path_id is not None:
-        track = element_track(_choose(elements, path_id), unit_m)
-        if track is None:
-            raise TrackError(f"path {path_id!r} has zero length")
+        track = _choose(elements, unit_m, path_id)
+    elif entries := _entries(elements, unit_m):
+        track = max((e.track for e in entries), key=lambda t: t.length_m)
     else:
-        tracks = [t for t in (element_track(e, unit_m) for e in elements) if t is not None]
-        if not tracks:
-            raise TrackError("the document has no path of positive length")
-        track = max(tracks, key=lambda t: t.length_m)
-    if width_m is not None:
-        track = Track(
-            name=track.name, closed=track.closed, width_m=width_m, segments=track.segments
-        )
-    return track
+        raise TrackError("the document has no path of positive length")
+    return track if width_m is None else track.with_width(width_m)
+
+
+def _measures(track: Track, unit_m: float) -> dict:
+    return {"closed": track.closed, "length_m": track.length_m,
+            "length_user": track.length_m / unit_m, "bbox_m": list(track.bbox())}
 
 
 def inspect_svg(path_or_bytes: Source, *, unit: str | None = None) -> dict:
-    """Every rendered path-like element with its length, box and width: `track inspect --json`."""
+    """Every rendered path-like element, `track inspect --json`: its selector (what ``path_id``
+    takes), whole length (all subpaths, as a browser's getTotalLength), box and width (None
+    where the stroke width is zero); an element with several subpaths is followed by one entry
+    per subpath, selector ``NAME:K``.
+    """
     root = parse_document(path_or_bytes)
     unit_m = document_unit_m(root.attrib, unit)
     paths = []
-    for elem in collect_elements(root):
-        track = element_track(elem, unit_m)
-        if track is None:
-            continue
-        paths.append(
-            {
-                "id": elem.id,
-                "label": elem.label,
-                "closed": track.closed,
-                "length_m": track.length_m,
-                "length_user": track.length_m / unit_m,
-                "bbox_m": list(track.bbox()),
-                "width_m": track.width_m,
-            }
-        )
+    for entry in _entries(collect_elements(root), unit_m):
+        parts = [t for t in entry.subpaths if t is not None]
+        boxes = np.array([t.bbox() for t in parts])
+        base = {"selector": entry.selector, "id": entry.elem.id, "label": entry.elem.label,
+                "subpath": None, "width_m": entry.width_m}
+        length = sum(t.length_m for t in parts)
+        paths.append({**base, "closed": entry.track.closed, "length_m": length,
+                      "length_user": length / unit_m,
+                      "bbox_m": [*boxes[:, :2].min(axis=0).tolist(),
+                                 *boxes[:, 2:].max(axis=0).tolist()]})
+        if len(entry.subpaths) > 1:
+            paths += [{**base, "selector": f"{entry.selector}:{k}", "subpath": k,
+                       **_measures(t, unit_m)}
+                      for k, t in enumerate(entry.subpaths) if t is not None]
     return {"unit_m": unit_m, "paths": paths}

@@ -68,8 +68,11 @@ def inspect(
     print(f"1 user unit = {report['unit_m']:g} m")
     for p in report["paths"]:
         kind = "loop" if p["closed"] else "road"
-        name = p["id"] if p["label"] is None else f"{p['id']} ({p['label']})"
-        print(f"{name}: {kind}, {p['length_m']:.4f} m, width {p['width_m']:.3f} m")
+        label = p["label"] if p["label"] not in (None, p["selector"]) else None
+        name = p["selector"] if label is None else f"{p['selector']} ({label})"
+        width = "no width" if p["width_m"] is None else f"width {p['width_m']:.3f} m"
+        indent = "  " if p["subpath"] is not None else ""
+        print(f"{indent}{name}: {kind}, {p['length_m']:.4f} m, {width}")
 
 
 @track_cli.command("sample")

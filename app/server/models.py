@@ -95,13 +95,16 @@ class TrackGeometry(BaseModel):
 
 
 class SvgPath(BaseModel):
+    selector: str = Field(description="what the upload's 'path' takes: the id, else the label, "
+                                      "else TAG-K (document order); NAME:K for a subpath")
     id: str | None
     label: str | None
+    subpath: int | None = Field(description="the subpath's index; null for the whole element")
     closed: bool
-    length_m: float
+    length_m: float = Field(description="an element's: all its subpaths (getTotalLength)")
     length_user: float
     bbox_m: tuple[float, float, float, float]
-    width_m: float
+    width_m: float | None = Field(description="null: a zero stroke width")
 
 
 class SvgPaths(BaseModel):

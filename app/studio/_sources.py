@@ -37,7 +37,7 @@ class Sources:
         """Offer the file's paths; the first one is shown."""
         data = self.ui.svg_upload.value.content
         try:
-            paths = [p["id"] for p in tracks.inspect_svg(data)["paths"]]
+            paths = [p["selector"] for p in tracks.inspect_svg(data)["paths"]]
         except (tracks.TrackError, ValueError, KeyError) as exc:
             self.notify("SVG not loaded", str(exc))
             return
