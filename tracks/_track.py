@@ -44,6 +44,9 @@ class Track:
     closed: bool
     width_m: float
     segments: tuple[Segment, ...]
+    # (right, left) widths from the centreline at each segment's start and the last end, as a
+    # centreline CSV gives them (None: width_m/2 each side); linear in s between junctions.
+    side_widths: np.ndarray | None = None
     chain: Chain = field(init=False, repr=False)
     table: LengthTable = field(init=False, repr=False)
     _profiles: dict = field(init=False, repr=False, default_factory=dict)
@@ -62,6 +65,10 @@ class Track:
             object.__setattr__(
                 self, "segments", tuple(np.asarray(self.segments, dtype=object)[keep])
             )
+            if self.side_widths is not None:
+                object.__setattr__(
+                    self, "side_widths", self.side_widths[np.concatenate([[True], keep])]
+                )
             chain = Chain(self.segments)
             table = length_table(chain.velocity, chain.count, breaks=chain.kinks())
         object.__setattr__(self, "chain", chain)
@@ -72,8 +79,19 @@ class Track:
         return self.table.length
 
     def with_width(self, width_m: float) -> Track:
-        """The same centreline at another width (a scenario's ``track.width_m``)."""
-        return replace(self, width_m=width_m)
+        """The same centreline at another, constant width (a scenario's ``track.width_m``)."""
+        return replace(self, width_m=width_m, side_widths=None)
+
+    def widths_at(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Widths to the right and to the left of the driving direction at arc lengths ``s``."""
+        s = np.atleast_1d(s)
+        if self.side_widths is None:
+            half = np.full(s.shape, self.width_m / 2.0)
+            return half, half
+        junctions = np.concatenate([[0.0], np.cumsum(self.table.segment_lengths(
+            self.chain.count))])
+        return (np.interp(s, junctions, self.side_widths[:, 0]),
+                np.interp(s, junctions, self.side_widths[:, 1]))
 
     def points_at(self, s: np.ndarray) -> np.ndarray:
         """World points (n, 2) at arc lengths ``s`` from the start (clipped to the track)."""
@@ -108,16 +126,17 @@ class Track:
         return self._profiles[key]
 
     def boundaries(self, spacing: float = 0.02) -> tuple[np.ndarray, np.ndarray]:
-        """Left and right edges (each (N, 2)): the centreline offset by ±width/2 along the normal.
+        """Left and right edges (each (N, 2)): the centreline offset along the normal by the
+        widths to each side (`widths_at`; width/2 unless the track has side widths).
 
-        Where the curvature radius is below width/2 an offset curve folds over itself; use
+        Where the curvature radius is below the offset an edge folds over itself; use
         `region_rings` for the drivable area itself.
         """
         prof = self.sample(spacing)
-        half = self.width_m / 2.0
+        right, left = self.widths_at(prof.s)
         centre = np.column_stack([prof.x, prof.y])
         normal = np.column_stack([-np.sin(prof.heading), np.cos(prof.heading)])
-        return centre + half * normal, centre - half * normal
+        return centre + left[:, None] * normal, centre - right[:, None] * normal
 
     def detail_spacing(self) -> float:
         """A sampling step that shows the track's shape: 5 cm, finer on a narrow track (a
@@ -131,15 +150,23 @@ class Track:
         sampled every ``spacing`` m (default `detail_spacing`).
 
         The sampled centreline is buffered by width/2 (flat ends, mitred joins), which stays
-        right where the offset curves fold. A loop gives [outer, inner], a road one ring; any
-        point is drivable iff it is inside an odd number of rings.
+        right where the offset curves fold; with side widths the region is the union of the
+        quadrilaterals between consecutive edge points. A loop gives [outer, inner], a road one
+        ring; any point is drivable iff it is inside an odd number of rings.
         """
         import shapely
 
-        prof = self.sample(spacing or self.detail_spacing())
-        centre = np.column_stack([prof.x, prof.y])
-        line = shapely.LinearRing(centre[:-1]) if self.closed else shapely.LineString(centre)
-        region = line.buffer(self.width_m / 2.0, cap_style="flat", join_style="mitre")
+        spacing = spacing or self.detail_spacing()
+        if self.side_widths is None:
+            prof = self.sample(spacing)
+            centre = np.column_stack([prof.x, prof.y])
+            line = shapely.LinearRing(centre[:-1]) if self.closed else shapely.LineString(centre)
+            region = line.buffer(self.width_m / 2.0, cap_style="flat", join_style="mitre")
+        else:
+            left, right = self.boundaries(spacing)
+            quads = np.stack([left[:-1], left[1:], right[1:], right[:-1]], axis=1)
+            pieces = shapely.make_valid(shapely.polygons(quads))  # folds: bow ties
+            region = shapely.union_all(pieces[shapely.area(pieces) > 0])
         polygons = getattr(region, "geoms", [region])
         rings = [ring for poly in polygons for ring in (poly.exterior, *poly.interiors)]
         return [np.asarray(ring.coords)[:-1] for ring in rings]
