@@ -15,12 +15,14 @@ __all__ = ["TrackSource", "check_scenario", "run_plan", "track_loader"]
 
 
 class TrackSource(BaseModel):
-    """An uploaded SVG track that a scenario may name (by ``id``) as its drivable region."""
+    """An uploaded track that a scenario may name (by ``id``) as its drivable region: the file
+    (``svg`` holds an SVG or a centreline CSV) and the options it was uploaded with."""
 
     id: str
     svg: bytes
     path: str | None = None
     unit: str | None = None
+    closed: bool | None = None
 
 
 def track_loader(track: TrackSource | None):
@@ -29,7 +31,8 @@ def track_loader(track: TrackSource | None):
 
     def load_track(name: str):
         if track is not None and name == track.id:
-            return tracks.load_svg(track.svg, path_id=track.path, unit=track.unit)
+            return tracks.load_track(track.svg, path_id=track.path, unit=track.unit,
+                                     closed=track.closed)
         return tracks.load_library_track(name)
 
     return load_track

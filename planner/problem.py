@@ -65,14 +65,16 @@ class Problem:
 
 
 def resolve_track(scenario: Scenario, load_track=None):
-    """The scenario's track: embedded SVG, else ``load_track(name)`` (default: the library)."""
+    """The scenario's track: embedded SVG or CSV, else ``load_track(name)`` (default: the
+    library)."""
     import tracks  # imported lazily: a track is optional, and tracks needs svg libraries
 
     if load_track is None:
         load_track = tracks.load_library_track
     try:
-        if scenario.track.svg is not None:
-            track = tracks.load_svg(scenario.track.svg.encode())
+        if scenario.track.embedded is not None:
+            track = tracks.load_track(scenario.track.embedded.encode(),
+                                      closed=scenario.track.closed)
         else:
             track = load_track(scenario.track.name)
     except (KeyError, ValueError) as exc:

@@ -171,12 +171,26 @@ Obstacle = Annotated[Circle | Polygon | Box, Field(discriminator="type")]
 
 class TrackRef(StrictModel):
     """The drivable region (rich schema): a library track by name, or any track embedded as
-    the Inkscape SVG `Track.to_svg` writes, so a scenario drawn or uploaded in the studio is
-    self-contained (``name`` then only labels it)."""
+    the Inkscape SVG `Track.to_svg` writes or as a centreline CSV (TUM / F1TENTH layout), so a
+    scenario drawn or uploaded in the studio is self-contained (``name`` then only labels it).
+    ``closed`` reads a CSV as a loop (default) or a road."""
 
     name: str
     width_m: Positive | None = None
     svg: str | None = None
+    csv: str | None = None
+    closed: bool | None = None
+
+    @model_validator(mode="after")
+    def _one_file(self) -> TrackRef:
+        if self.svg is not None and self.csv is not None:
+            raise ValueError("give one of 'svg' and 'csv'")
+        return self
+
+    @property
+    def embedded(self) -> str | None:
+        """The embedded track file's text (SVG or CSV); None for a track named only."""
+        return self.svg if self.svg is not None else self.csv
 
 
 class Scenario(StrictModel):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import re
 import subprocess
 import xml.etree.ElementTree as ET
@@ -305,3 +306,49 @@ def test_plan_by_id_on_an_uploaded_track(server):
 def test_bad_plan_options_are_422(server, body, words):
     resp = server.client.post("/plan", json=body)
     assert resp.status_code == 422 and words in json.dumps(resp.json()["detail"]), resp.text
+
+
+def _circle_csv(r: float, n: int = 120, right: float = 0.4, left: float = 0.6) -> bytes:
+    rows = [f"{r * math.cos(2 * math.pi * k / n)!r},{r * math.sin(2 * math.pi * k / n)!r},"
+            f"{right},{left}" for k in range(n)]
+    return ("# x_m,y_m,w_tr_right_m,w_tr_left_m\n" + "\n".join(rows)).encode()
+
+
+def test_a_centreline_csv_uploads_with_its_curvature_raceline_and_scenario(server):
+    resp = upload(server, _circle_csv(3.0), filename="ring.csv")
+    assert resp.status_code == 201, resp.text
+    track = resp.json()
+    assert track["name"] == "ring" and track["closed"] and track["width_m"] == pytest.approx(1.0)
+    assert track["length_m"] == pytest.approx(2 * math.pi * 3.0, rel=1e-4)
+    profile = server.client.get(f"/tracks/{track['id']}/profile", params={"spacing": 0.1}).json()
+    kappa = [p["curvature"] for p in profile["points"]]
+    assert kappa == pytest.approx([1 / 3.0] * len(kappa), rel=5e-3)
+    paths = server.client.get(f"/tracks/{track['id']}/paths").json()["paths"]
+    assert [(p["selector"], p["width_m"]) for p in paths] == [("centerline", 1.0)]
+    line = server.client.get(f"/tracks/{track['id']}/raceline.csv",
+                             params={"v_max": 10, "a_lat_max": 3}).text.splitlines()
+    assert line[0] == "# s_m; x_m; y_m; psi_rad; kappa_radpm; vx_mps; ax_mps2"
+    assert float(line[1].split(";")[5]) == pytest.approx(3.0, rel=5e-3)  # √(A·r)
+    centre = server.client.get(f"/tracks/{track['id']}/centerline.csv").text.splitlines()
+    assert centre[1].split(",")[2:] == ["0.4000000", "0.6000000"]
+    scenario = {"name": "ring", "track": {"name": track["id"]},
+                "start": [3.0, 0.0, 1.5708], "goal": [-3.0, 0.0, -1.5708]}
+    assert server.client.post("/scenarios", json=scenario).status_code == 201
+    road = upload(server, _circle_csv(3.0), filename="arc.csv", closed="false").json()
+    assert not road["closed"] and road["length_m"] < track["length_m"]
+
+
+@pytest.mark.parametrize("data, form, words", [
+    (b"0,0,1,1\n1,0,1,1\n2,1,1\n3,3,1,1\n", {}, "cannot use this CSV: t line 3: expected 4"),
+    (b"", {}, "no points"),
+    (b"0,0,1,1\n1,0,1,1\n2,1,1,1\n3,3,1,1\n", {"unit": "mm"}, "'unit' is for SVG"),
+])
+def test_bad_csv_uploads_are_refused_with_the_line(server, data, form, words):
+    resp = upload(server, data, filename="t.csv", **form)
+    assert resp.status_code == 400 and words in resp.json()["detail"]
+
+
+def test_raceline_options_are_checked(server):
+    for params in ({"a_long_max": 0}, {"spacing": -1}, {"spacing": 1e-7}):
+        resp = server.client.get("/tracks/thesis/raceline.csv", params=params)
+        assert resp.status_code == 422, params

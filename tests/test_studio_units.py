@@ -192,3 +192,27 @@ def test_a_run_that_ends_between_metric_updates_still_shows_its_last_numbers():
         assert worker.live.metrics["nodes"] == worker._run.nodes > 2
     finally:
         worker.stop()
+
+
+def test_an_uploaded_csv_track_is_offered_shown_and_embedded_with_its_side_widths():
+    from types import SimpleNamespace
+
+    from app.studio._sources import Sources
+
+    n, r = 60, 4.0
+    rows = [f"{r * math.cos(2 * math.pi * k / n)},{r * math.sin(2 * math.pi * k / n)},0.5,1.0"
+            for k in range(n)]
+    ui = SimpleNamespace(svg_upload=SimpleNamespace(value=SimpleNamespace(
+        name="ring.csv", content="\n".join(rows).encode())),
+        svg_path=SimpleNamespace(options=(), visible=False, value="—"))
+    shown = []
+    sources = Sources(None, ui, None, "", lambda track, scenario: shown.append((track, scenario)),
+                      lambda *message: pytest.fail(str(message)))
+    sources.svg_uploaded()
+    assert ui.svg_path.options == ("ring",) and not ui.svg_path.visible
+    ui.svg_path.value = "ring"  # what the dropdown's update fires
+    sources.svg_path_chosen()
+    track, scenario = shown[-1]
+    again = resolve_track(planner.parse_scenario(json.loads(json.dumps(scenario))))
+    assert again.length_m == pytest.approx(track.length_m, rel=1e-6) and again.closed
+    assert [w[0] for w in again.widths_at(np.array([1.0]))] == pytest.approx([0.5, 1.0])

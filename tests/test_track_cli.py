@@ -120,3 +120,24 @@ def test_bad_input_exits_2_with_one_line_on_stderr_within_a_second(tmp_path, arg
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: "), done.stderr
     assert seconds < 1.0
+
+
+def test_csv_in_export_and_raceline_out(tmp_path):
+    done, _ = run("export", "thesis", "-o", str(tmp_path / "thesis.csv"), "--spacing", "0.1")
+    assert done.returncode == 0, done.stderr
+    done, _ = run("inspect", str(tmp_path / "thesis.csv"), "--json")
+    (entry,) = json.loads(done.stdout)["paths"]
+    assert entry["closed"] and entry["width_m"] == pytest.approx(0.5)
+    assert entry["length_m"] == pytest.approx(14.0033259, rel=1e-4)
+    done, _ = run("raceline", str(tmp_path / "thesis.csv"), "--open", "--v-max", "2.5")
+    lines = done.stdout.splitlines()
+    assert lines[0] == "# s_m; x_m; y_m; psi_rad; kappa_radpm; vx_mps; ax_mps2"
+    vx = [float(line.split(";")[5]) for line in lines[1:]]
+    assert vx[0] == vx[-1] == 0 and max(vx) == pytest.approx(2.5)  # a road: from and to rest
+
+
+def test_a_bad_csv_exits_2_with_one_line_naming_the_line(tmp_path):
+    (tmp_path / "bad.csv").write_text("# x_m,y_m,w_tr_right_m,w_tr_left_m\n0,0,1,1\n1,0,-1,1\n")
+    done, _ = run("sample", "bad.csv", cwd=tmp_path)
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.strip() == "error: bad line 3: negative width"

@@ -24,7 +24,7 @@ def _positive(name: str, value: float) -> float:
 
 
 def check_sampling(
-    spacing: float, wheelbase: float, max_steer_deg: float
+    spacing: float, wheelbase: float = 0.44, max_steer_deg: float = 26.0
 ) -> tuple[float, float, float]:
     """The sampling parameters, validated: positive spacing and wheelbase, 0 < δmax < 90°."""
     if not (isinstance(max_steer_deg, int | float) and 0 < max_steer_deg < 90):

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import sys
+from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -25,15 +27,25 @@ def plan(
     scenario: ScenarioArg,
     options: PlanOptions,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    raceline: Annotated[Path | None, typer.Option(
+        "--raceline", help="Also write the best path in the TUM raceline layout (speed within "
+                           "the vehicle's max speed, 4 m/s² lateral, 2 m/s² longitudinal).",
+    )] = None,
 ) -> None:
     """Plan a path for the car from start to goal with RRT or RRT*."""
     import planner as core
     from app.planning import run_plan
+    from app.raceline import path_raceline, raceline_limits
 
     with user_errors():
         scenario_model = core.load_scenario(scenario)
         warm_kernels()
         report = run_plan(scenario_model, options)
+        if raceline is not None and report.solved:
+            limits = raceline_limits(vehicle=scenario_model.vehicle)
+            raceline.write_text(path_raceline(report.path, limits))
+        elif raceline is not None:
+            print(f"{raceline} not written: no path was found", file=sys.stderr)
     if as_json:
         typer.echo(report.model_dump_json())
         return

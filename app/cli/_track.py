@@ -1,7 +1,8 @@
-"""`trackstar track …`: inspect, sample and plot Inkscape tracks.
+"""`trackstar track …`: inspect, sample, plot and export tracks; racelines.
 
-FILE may also name a library track (`trackstar track sample thesis`) when no such file exists.
-Imports of the tracks layer happen inside the commands so that `--help` and bad input stay fast.
+FILE is an Inkscape SVG or a centreline CSV (TUM / F1TENTH layout), or names a library track
+(`trackstar track sample thesis`) when no such file exists. Imports of the tracks layer happen
+inside the commands so that `--help` and bad input stay fast.
 """
 
 from __future__ import annotations
@@ -16,18 +17,33 @@ import typer
 
 from app.cli._errors import user_errors
 
-track_cli = typer.Typer(help="Inspect, sample and plot Inkscape tracks.", no_args_is_help=True,
+track_cli = typer.Typer(help="Inspect, sample, plot and export tracks (Inkscape SVG or "
+                             "centreline CSV); racelines.", no_args_is_help=True,
                         rich_markup_mode=None)
 
 FileArg = Annotated[
-    str, typer.Argument(metavar="FILE.svg", help="SVG file, or a library track name.")
+    str, typer.Argument(metavar="FILE", help="SVG or centreline CSV file, or a library track name.")
 ]
 UnitOpt = Annotated[
     str | None,
     typer.Option("--unit", help="What one user unit measures: m, cm, mm, in, pt, pc, px."),
 ]
 PathOpt = Annotated[
-    str | None, typer.Option("--path", help="Element id or inkscape:label (default: longest path).")
+    str | None,
+    typer.Option("--path", help="SVG: a selector from inspect (id, label, TAG-K, NAME:K; "
+                                "default: the longest path)."),
+]
+OpenOpt = Annotated[
+    bool, typer.Option("--open", help="Read a centreline CSV as a road (default: a loop).")
+]
+OutputOpt = Annotated[Path | None, typer.Option("-o", "--output", help="File (default: stdout).")]
+VMaxOpt = Annotated[
+    float | None,
+    typer.Option("--v-max", help="Speed limit [m/s] (default: the default vehicle's, 1.0)."),
+]
+ALatOpt = Annotated[float, typer.Option("--a-lat-max", help="Lateral acceleration limit [m/s²].")]
+ALongOpt = Annotated[
+    float, typer.Option("--a-long-max", help="Longitudinal acceleration limit [m/s²].")
 ]
 SpacingOpt = Annotated[float, typer.Option("--spacing", help="Distance between target points [m].")]
 WheelbaseOpt = Annotated[float, typer.Option("--wheelbase", help="Wheelbase L [m].")]
@@ -38,30 +54,41 @@ def _source(file: str) -> Path:
     from tracks import TrackError, library_names, library_path
 
     path = Path(file)
+    if path.is_file():
+        return path
+    if file in library_names():  # also beside a directory of that name
+        return library_path(file)
     if path.exists():
         return path
-    if file in library_names():
-        return library_path(file)
     raise TrackError(f"no such file: {file} (nor a library track: {', '.join(library_names())})")
 
 
-def _load(file: str, path_id: str | None, unit: str | None):
-    from tracks import load_svg
+def _load(file: str, path_id: str | None, unit: str | None, open_: bool):
+    from tracks import load_track
 
-    return load_svg(_source(file), path_id=path_id, unit=unit)
+    return load_track(_source(file), path_id=path_id, unit=unit, closed=False if open_ else None)
+
+
+def _write(text: str, output: Path | None) -> None:
+    if output is None:
+        sys.stdout.write(text)
+        return
+    output.write_text(text)
+    print(output)
 
 
 @track_cli.command("inspect")
 def inspect(
     file: FileArg,
     unit: UnitOpt = None,
+    open_: OpenOpt = False,
     as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
 ) -> None:
-    """List every rendered path with length, bounding box and width (transforms applied)."""
+    """List every rendered path with its selector, length, bounding box and width."""
     with user_errors():
-        from tracks import inspect_svg
+        from tracks import inspect_track
 
-        report = inspect_svg(_source(file), unit=unit)
+        report = inspect_track(_source(file), unit=unit, closed=False if open_ else None)
     if as_json:
         print(json.dumps(report))
         return
@@ -80,6 +107,7 @@ def sample(
     file: FileArg,
     path: PathOpt = None,
     unit: UnitOpt = None,
+    open_: OpenOpt = False,
     spacing: SpacingOpt = 0.02,
     wheelbase: WheelbaseOpt = 0.44,
     max_steer_deg: SteerOpt = 26.0,
@@ -95,7 +123,7 @@ def sample(
         from tracks import check_sampling
 
         check_sampling(spacing, wheelbase, max_steer_deg)
-        profile = _load(file, path, unit).sample(spacing, wheelbase, max_steer_deg)
+        profile = _load(file, path, unit, open_).sample(spacing, wheelbase, max_steer_deg)
     if as_json:
         print(json.dumps(profile.to_dict()))
     elif as_csv:
@@ -117,19 +145,76 @@ def plot(
     output: Annotated[Path, typer.Option("-o", "--output", help="profile.png, .svg or .pdf")],
     path: PathOpt = None,
     unit: UnitOpt = None,
+    open_: OpenOpt = False,
     spacing: SpacingOpt = 0.02,
     wheelbase: WheelbaseOpt = 0.44,
     max_steer_deg: SteerOpt = 26.0,
+    v_max: VMaxOpt = None,
+    a_lat_max: ALatOpt = 4.0,
+    a_long_max: ALongOpt = 2.0,
 ) -> None:
-    """Draw the track with its boundaries, and curvature and steering angle over s."""
+    """Draw the track with its boundaries, and curvature, steering angle and the raceline's
+    speed over s."""
     with user_errors():
+        from app.raceline import raceline_limits
         from tracks import check_sampling
         from tracks.plot import figure_path, plot_profile
 
         figure_path(output)
         check_sampling(spacing, wheelbase, max_steer_deg)
-        track = _load(file, path, unit)
+        limits = raceline_limits(v_max, a_lat_max, a_long_max)
+        track = _load(file, path, unit, open_)
         written = plot_profile(
-            track, track.sample(spacing, wheelbase, max_steer_deg), output, max_steer_deg
+            track, track.sample(spacing, wheelbase, max_steer_deg), output, max_steer_deg, limits
         )
     print(written)
+
+
+@track_cli.command("export")
+def export(
+    file: FileArg,
+    output: OutputOpt = None,
+    fmt: Annotated[
+        str, typer.Option("--format", help="tum-centerline (x_m,y_m,w_tr_right_m,w_tr_left_m) "
+                                           "or svg (Inkscape, mm).")
+    ] = "tum-centerline",
+    path: PathOpt = None,
+    unit: UnitOpt = None,
+    open_: OpenOpt = False,
+    spacing: Annotated[
+        float, typer.Option("--spacing", help="Distance between CSV rows [m].")
+    ] = 0.05,
+) -> None:
+    """Write the track as a centreline CSV or as an Inkscape SVG."""
+    with user_errors():
+        from app.cli._errors import InputError
+        from tracks import centerline_csv
+
+        if fmt not in ("tum-centerline", "svg"):
+            raise InputError(f"--format must be tum-centerline or svg, got {fmt!r}")
+        track = _load(file, path, unit, open_)
+        text = track.to_svg() if fmt == "svg" else centerline_csv(track, spacing)
+        _write(text, output)
+
+
+@track_cli.command("raceline")
+def raceline(
+    file: FileArg,
+    output: OutputOpt = None,
+    path: PathOpt = None,
+    unit: UnitOpt = None,
+    open_: OpenOpt = False,
+    spacing: Annotated[float, typer.Option("--spacing", help="Distance between rows [m].")] = 0.05,
+    v_max: VMaxOpt = None,
+    a_lat_max: ALatOpt = 4.0,
+    a_long_max: ALongOpt = 2.0,
+) -> None:
+    """The centreline in the TUM raceline layout (s_m; x_m; y_m; psi_rad; kappa_radpm; vx_mps;
+    ax_mps2) with the fastest speed profile within the limits."""
+    with user_errors():
+        from app.raceline import raceline_limits
+        from tracks import raceline_csv, raceline_rows
+
+        limits = raceline_limits(v_max, a_lat_max, a_long_max)
+        track = _load(file, path, unit, open_)
+        _write(raceline_csv(raceline_rows(track.sample(spacing), limits)), output)

@@ -40,7 +40,7 @@ def resolve(request: Request, scenario: planner.Scenario | str
     """
     if isinstance(scenario, str):
         scenario = planner.parse_scenario(stored_scenario(request, scenario)["scenario"])
-    if (scenario.track is None or scenario.track.svg is not None
+    if (scenario.track is None or scenario.track.embedded is not None
             or scenario.track.name in tracks.library_names()):
         return scenario, None
     row = request.app.state.store.track(scenario.track.name)
@@ -48,7 +48,7 @@ def resolve(request: Request, scenario: planner.Scenario | str
         raise planner.ScenarioError(f"track.name: no track {scenario.track.name!r}: give a "
                                     f"library name or an uploaded track's id")
     return scenario, TrackSource(id=row["id"], svg=row["svg"], path=row["path"],
-                                 unit=row["unit"])
+                                 unit=row["unit"], closed=bool(row["closed"]))
 
 
 @router.get("/scenarios/schema")

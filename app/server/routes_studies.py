@@ -70,10 +70,10 @@ def _parse(body: dict) -> Study:
             scenario = planner.parse_scenario(source)
         else:
             scenario = planner.load_scenario(planner.bundled_scenario_path(source))
-        if (scenario.track is not None and scenario.track.svg is None
+        if (scenario.track is not None and scenario.track.embedded is None
                 and scenario.track.name not in tracks.library_names()):
             raise planner.ScenarioError("track.name: a study's scenarios use library tracks or "
-                                        "an embedded SVG")
+                                        "an embedded SVG or CSV")
         return scenario
 
     return parse_study(body, "", resolve)

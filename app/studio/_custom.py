@@ -1,9 +1,10 @@
-"""Tracks that are not in the library (uploaded SVG, drawn): scenarios that embed them, and the
-drawing itself (anchors with Bézier handles).
+"""Tracks that are not in the library (uploaded SVG or CSV, drawn): scenarios that embed them,
+and the drawing itself (anchors with Bézier handles).
 
 A custom track goes into the scenario as the Inkscape SVG `Track.to_svg` writes
-(``track.svg``), so a saved or downloaded scenario loads back with its track and the planner
-sees the same drivable region as for a library track.
+(``track.svg``), or, when it has side widths (an uploaded centreline CSV), as the centreline CSV
+`tracks.centerline_csv` writes (``track.csv``), so a saved or downloaded scenario loads back with
+its track and the planner sees the same drivable region as for a library track.
 """
 
 from __future__ import annotations
@@ -23,9 +24,11 @@ def custom_scenario(track: tracks.Track, name: str) -> dict:
     """A scenario embedding ``track`` (start at s = 0, goal 3/4 lap or 90 % along)."""
     prof = track.sample(track.detail_spacing())
     start_s = 0.0 if track.closed else 0.05 * track.length_m
+    ref = ({"svg": track.to_svg()} if track.side_widths is None
+           else {"csv": tracks.centerline_csv(track), "closed": track.closed})
     return {
         "name": name,
-        "track": {"name": track.name or name, "svg": track.to_svg()},
+        "track": {"name": track.name or name, **ref},
         "start": pose_at(prof, start_s),
         "goal": pose_at(prof, goal_fraction(track.closed) * track.length_m),
         "goal_tolerance": {"position": min(0.25, track.width_m / 2), "heading_deg": 30},

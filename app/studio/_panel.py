@@ -72,7 +72,8 @@ class Panel:
 def build_panel(gui) -> Panel:
     with gui.add_folder("Track"):
         track = gui.add_dropdown("Track", tuple(tracks.library_names()), initial_value="thesis")
-        svg_upload = gui.add_upload_button("Upload SVG", mime_type=".svg,image/svg+xml")
+        svg_upload = gui.add_upload_button("Upload SVG or CSV",
+                                           mime_type=".svg,.csv,image/svg+xml,text/csv")
         svg_path = gui.add_dropdown("SVG path", ("—",), visible=False)
         fit = gui.add_button("Fit view")
     with gui.add_folder("Draw a track", expand_by_default=False):

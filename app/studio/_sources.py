@@ -1,7 +1,7 @@
-"""Tracks and scenarios into and out of a tab: the library, an uploaded SVG, scenario JSON files
-and the server's scenario store.
+"""Tracks and scenarios into and out of a tab: the library, an uploaded SVG or centreline CSV,
+scenario JSON files and the server's scenario store.
 
-`Sources` holds only the uploaded SVG, kept so that another of its paths can be chosen; what it
+`Sources` holds only the uploaded file, kept so that another of its paths can be chosen; what it
 loads goes to ``set_track`` (the session's, which puts it on the stage and resets the rest).
 """
 
@@ -27,24 +27,26 @@ class Sources:
         """``api_url`` is the REST API's base URL (it ends in /api/v1)."""
         self.client, self.ui, self.stage, self.api_url = client, ui, stage, api_url
         self._set_track, self.notify = set_track, notify
-        self._svg: str | None = None  # the uploaded file
+        self._upload = None  # the uploaded file (viser's UploadedFile: name, content)
 
     # -- tracks ---------------------------------------------------------------------------------
     def show_library(self, name: str) -> None:
         self._set_track(tracks.load_library_track(name), default_scenario(name))
 
     def svg_uploaded(self) -> None:
-        """Offer the file's paths; the first one is shown."""
-        data = self.ui.svg_upload.value.content
+        """Offer the file's paths (an SVG's elements, a CSV's one centreline); the first one is
+        shown."""
+        upload = self.ui.svg_upload.value
         try:
-            paths = [p["selector"] for p in tracks.inspect_svg(data)["paths"]]
+            report = tracks.inspect_track(upload.content, filename=upload.name)
         except (tracks.TrackError, ValueError, KeyError) as exc:
-            self.notify("SVG not loaded", str(exc))
+            self.notify("Track not loaded", str(exc))
             return
+        paths = [p["selector"] for p in report["paths"]]
         if not paths:
-            self.notify("SVG not loaded", "the file has no path")
+            self.notify("Track not loaded", "the file has no path")
             return
-        self._svg = data
+        self._upload = upload
         self.ui.svg_path.options = tuple(paths)
         self.ui.svg_path.visible = len(paths) > 1
         if self.ui.svg_path.value == paths[0]:
@@ -53,12 +55,13 @@ class Sources:
             self.ui.svg_path.value = paths[0]  # fires svg_path_chosen
 
     def svg_path_chosen(self) -> None:
-        if self._svg is None or self.ui.svg_path.value not in self.ui.svg_path.options:
+        if self._upload is None or self.ui.svg_path.value not in self.ui.svg_path.options:
             return
         try:
-            track = tracks.load_svg(self._svg, path_id=self.ui.svg_path.value)
+            track = tracks.load_track(self._upload.content, path_id=self.ui.svg_path.value,
+                                      filename=self._upload.name)
         except (tracks.TrackError, ValueError) as exc:
-            self.notify("SVG not loaded", str(exc))
+            self.notify("Track not loaded", str(exc))
             return
         self.use_track(track)
 
