@@ -216,3 +216,20 @@ def test_an_uploaded_csv_track_is_offered_shown_and_embedded_with_its_side_width
     again = resolve_track(planner.parse_scenario(json.loads(json.dumps(scenario))))
     assert again.length_m == pytest.approx(track.length_m, rel=1e-6) and again.closed
     assert [w[0] for w in again.widths_at(np.array([1.0]))] == pytest.approx([0.5, 1.0])
+
+
+def test_the_raceline_download_is_the_best_path_within_the_scenario_vehicle():
+    from types import SimpleNamespace
+
+    from app.studio._planner_run import PlannerRun
+
+    run = PlannerRun(None, None, None, None, None, None)
+    assert run.raceline() is None  # no run yet
+    scenario = planner.parse_scenario(dict(default_scenario("thesis"),
+                                           vehicle={"speed": 1.0, "max_speed": 1.5}))
+    path = np.column_stack([np.linspace(0, 6, 121), np.zeros(121), np.zeros(121)])
+    run.worker = SimpleNamespace(live=SimpleNamespace(best_path=path))
+    run.stage = SimpleNamespace(parsed=scenario)
+    lines = run.raceline().splitlines()
+    vx = [float(line.split(";")[5]) for line in lines[1:]]
+    assert lines[0].startswith("# s_m; x_m") and max(vx) == pytest.approx(1.5) and vx[-1] == 0

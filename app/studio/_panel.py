@@ -63,6 +63,7 @@ class Panel:
     step: object
     reset: object
     drive: object
+    raceline_download: object
     status: object
     metrics: object
     extend: object
@@ -122,6 +123,8 @@ def build_panel(gui) -> Panel:
         step = gui.add_button("Step")
         reset = gui.add_button("Reset")
         drive = gui.add_button("Drive car")
+        raceline_download = gui.add_button("Download raceline (CSV)",
+                                            hint="The best path in the TUM raceline layout")
         status = gui.add_markdown("Status: ready")
     with gui.add_folder("Metrics"):
         metrics = gui.add_markdown("—")

@@ -15,6 +15,7 @@ import numpy as np
 
 import planner
 import tracks
+from app.raceline import path_raceline, raceline_limits
 from app.studio._extend import FIRST_NOTE, explain, render
 from app.studio._live_view import LiveView
 from app.studio._panel import PLANNERS, SPEEDS, STEERINGS
@@ -93,6 +94,14 @@ class PlannerRun:
 
     def set_rate(self) -> None:
         self.worker.rate = SPEEDS[self.ui.rate.value]
+
+    def raceline(self) -> str | None:
+        """The best path in the TUM raceline layout within the scenario vehicle's limits (None
+        before a path is found)."""
+        path = self.worker.live.best_path if self.worker is not None else None
+        if path is None or not len(path):
+            return None
+        return path_raceline(path, raceline_limits(vehicle=self.stage.parsed.vehicle))
 
     # -- the car -------------------------------------------------------------------------------
     def drive(self) -> None:

@@ -98,6 +98,7 @@ class Session:
         u.pause.on_click(lambda _: run.worker.pause())
         u.step.on_click(lambda _: run.worker.step())
         u.drive.on_click(lambda _: self._locked(run.drive))
+        u.raceline_download.on_click(lambda _: self._download_raceline())
         sim.ui.simulate.on_click(lambda _: self._simulate())
         sim.ui.stop.on_click(lambda _: sim.stop())
 
@@ -155,6 +156,13 @@ class Session:
         with self._lock:
             self.planning.reset()
             self.sim.start(self.stage.problem, settings)
+
+    def _download_raceline(self) -> None:
+        text = self.planning.raceline()
+        if text is None:
+            self.notify("No path yet", "press Run until a path to the goal is found")
+            return
+        self.client.send_file_download("raceline.csv", text.encode(), save_immediately=True)
 
     def notify(self, title: str, body: str) -> None:
         self.client.add_notification(title, body, auto_close_seconds=6.0, color="red")
