@@ -29,7 +29,7 @@ def test_inspect_json_lists_every_rendered_path_with_its_measures():
     done, _ = run("inspect", str(DATA / "nested_mm.svg"), "--json")
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
-    assert set(report) == {"unit_m", "paths"}
+    assert set(report) == {"format", "unit_m", "paths"} and report["format"] == "svg"
     keys = {"selector", "id", "label", "subpath", "closed", "length_m", "length_user", "bbox_m",
             "width_m"}
     assert all(set(p) == keys and len(p["bbox_m"]) == 4 for p in report["paths"])

@@ -62,12 +62,13 @@ def load_track(
 
 def inspect_track(source: Source, *, unit: str | None = None, closed: bool | None = None,
                   filename: str | None = None) -> dict:
-    """`inspect_svg`'s report; a CSV gives one entry (its width: the narrowest total width)."""
+    """`inspect_svg`'s report with its ``format`` ("svg" or "csv"); a CSV gives one entry (its
+    width: the narrowest total width) in metres."""
     data, filename = _read(source, filename)
     if is_svg(data, filename):
-        return inspect_svg(data, unit=unit)
+        return {"format": "svg", **inspect_svg(data, unit=unit)}
     track = _csv_track(data, filename, None, unit, closed)
-    return {"unit_m": 1.0, "paths": [{
+    return {"format": "csv", "unit_m": 1.0, "paths": [{
         "selector": track.name, "id": None, "label": None, "subpath": None,
         "closed": track.closed, "length_m": track.length_m, "length_user": track.length_m,
         "bbox_m": list(track.bbox()), "width_m": track.width_m}]}

@@ -92,7 +92,8 @@ def inspect(
     if as_json:
         print(json.dumps(report))
         return
-    print(f"1 user unit = {report['unit_m']:g} m")
+    if report["format"] == "svg":
+        print(f"1 user unit = {report['unit_m']:g} m")
     for p in report["paths"]:
         kind = "loop" if p["closed"] else "road"
         label = p["label"] if p["label"] not in (None, p["selector"]) else None
