@@ -420,7 +420,8 @@ def test_straight_line_steering_draws_the_classic_rrt_picture(browser, ui_url):
     page.close()
 
 
-def test_the_studies_folder_lists_the_servers_studies_and_downloads_a_report(browser, urls):
+def test_the_studies_folder_lists_the_servers_studies_opens_and_downloads_a_report(browser,
+                                                                                   urls):
     import httpx
 
     body = {"name": "tiny", "scenarios": ["open_field"], "planners": ["rrt"], "seeds": 2,
@@ -437,4 +438,10 @@ def test_the_studies_folder_lists_the_servers_studies_and_downloads_a_report(bro
     report = Path(dl.value.path()).read_text()
     assert dl.value.suggested_filename == "tiny.html"
     assert "<h1>Study tiny</h1>" in report and "data:image/png;base64," in report
+    click(page, "Open report")  # in a window over the scene, the page in a sandboxed frame
+    shown = page.frame_locator("iframe[title='report of tiny']")
+    shown.get_by_text("Best setting per scenario").wait_for(timeout=15000)
+    assert shown.locator("img").count() >= 3
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(ARTIFACTS / "study_report.png"))
     page.close()

@@ -1,11 +1,15 @@
 """The `Studies` folder: the server's parameter studies, their progress and their reports.
 
 A study runs on the server (POST /api/v1/studies, or `trackstar study` for a local one); the
-studio lists them and hands their self-contained report or their table to the browser as a
-download, so it opens wherever the browser is, whatever host name the API has.
+studio lists them, opens a study's report in a window beside the scene and hands the report or
+the table to the browser as a download. The studio fetches them from the API itself, so they
+open wherever the browser is, whatever host name the API has: the report is self-contained
+(every image inline), shown in a sandboxed frame of its own.
 """
 
 from __future__ import annotations
+
+import html
 
 import httpx
 
@@ -23,11 +27,15 @@ class StudiesView:
         with gui.add_folder("Studies", expand_by_default=False):
             self.choice = gui.add_dropdown("Study", (NONE,))
             self.refresh = gui.add_button("Refresh list")
+            self.open = gui.add_button("Open report")
             self.report = gui.add_button("Download report")
             self.table = gui.add_button("Download results (CSV)")
             self.status = gui.add_markdown("Studies run on the server: POST /api/v1/studies "
                                            "(docs/studies.md).")
+        self.gui = gui
+        self._window = None  # the open report's floating panel
         self.refresh.on_click(lambda _: self.load())
+        self.open.on_click(lambda _: self._open())
         self.report.on_click(lambda _: self._download("report.html", "html"))
         self.table.on_click(lambda _: self._download("results.csv", "csv"))
         self.choice.on_update(lambda _: self._show())
@@ -52,17 +60,40 @@ class StudiesView:
                                f"**{s['status']}**: {s['done']} of {s['total']} runs "
                                f"({s['failed']} failed, {s['skipped']} resumed)")
 
-    def _download(self, name: str, suffix: str) -> None:
+    def _fetch(self, name: str, failed: str) -> tuple[dict, bytes] | None:
+        """The chosen study and its file ``name`` from the API; None (and a notice) if not."""
         study = self._rows.get(self.choice.value)
         if study is None:
             self.notify("No study", "press Refresh list and choose a study")
-            return
-        study_id = study["id"]
+            return None
         try:
-            r = httpx.get(f"{self.api_url}/studies/{study_id}/{name}", timeout=120.0)
+            r = httpx.get(f"{self.api_url}/studies/{study['id']}/{name}", timeout=120.0)
             r.raise_for_status()
         except httpx.HTTPError as exc:
-            self.notify("Not downloaded", f"{name} of study {study_id}: {exc}")
+            self.notify(failed, f"{name} of study {study['id']}: {exc}")
+            return None
+        return study, r.content
+
+    def _download(self, name: str, suffix: str) -> None:
+        fetched = self._fetch(name, "Not downloaded")
+        if fetched is not None:
+            study, content = fetched
+            self.client.send_file_download(f"{study['name']}.{suffix}", content,
+                                           save_immediately=True)
+
+    def _open(self) -> None:
+        """The report in a floating window over the scene (one at a time), its page in a
+        sandboxed frame: scripts of the report cannot reach the studio."""
+        fetched = self._fetch("report.html", "Report not opened")
+        if fetched is None:
             return
-        self.client.send_file_download(f"{study['name']}.{suffix}", r.content,
-                                       save_immediately=True)
+        study, content = fetched
+        if self._window is not None:
+            self._window.remove()
+        self._window = self.gui.add_panel()
+        with self._window.add_tab(f"Report: {study['name']}"):
+            self.gui.add_html(
+                f'<iframe title="report of {html.escape(study["name"])}" sandbox '
+                f'srcdoc="{html.escape(content.decode("utf-8", "replace"), quote=True)}" '
+                'style="width:100%;height:70vh;border:0;background:white"></iframe>')
+        self._window.float(x=20, y=20, width=900, height=620)
