@@ -8,6 +8,7 @@ FORMAT.md), never with the simulator's own clearance code.
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 import subprocess
@@ -192,7 +193,8 @@ def test_cli_json_and_log_are_reproducible(tmp_path):
     outs = []
     for k in range(2):
         r = _cli(path, "--duration", 3, "--seed", 5, "--fixed-latency", 20, "--json",
-                 "--log", tmp_path / f"{k}.csv", "--controller", "stanley")
+                 "--log", tmp_path / f"{k}.csv", "--controller", "stanley",
+                 "--raceline", tmp_path / f"{k}_raceline.csv")
         assert r.returncode == 0, r.stderr
         outs.append(json.loads(r.stdout))
     a, b = ((tmp_path / f"{k}.csv").read_bytes() for k in range(2))
@@ -206,6 +208,16 @@ def test_cli_json_and_log_are_reproducible(tmp_path):
     rows = list(csv.reader(a.decode().splitlines()))
     assert len(rows) == 302 and rows[0][:8] == ["t", "x", "y", "theta", "v", "steer",
                                                 "obs0_dx", "obs0_dy"]
+    # The driven path in the TUM raceline layout: its poses are the log's, its speed the
+    # fastest within the car's limits (crossing: max speed unset, so its speed).
+    text = (tmp_path / "0_raceline.csv").read_text()
+    assert text.startswith("# s_m; x_m; y_m; psi_rad; kappa_radpm; vx_mps; ax_mps2\n")
+    line = np.loadtxt(io.StringIO(text), delimiter=";")
+    log = np.loadtxt(io.StringIO(a.decode()), delimiter=",", skiprows=1)
+    assert np.allclose(line[[0, -1], 1:3], log[[0, -1], 1:3], atol=1e-6)
+    assert np.all(np.diff(line[:, 0]) > 0) and line[-1, 0] == pytest.approx(s["distance_m"], 0.01)
+    speed = scenario_dict(path)["vehicle"]["speed"]
+    assert np.all(np.abs(line[:, 5]) <= speed + 1e-9) and np.all(np.abs(line[:, 6]) <= 2 + 1e-9)
 
 
 def _with(tmp_path, name="crossing", **changes):

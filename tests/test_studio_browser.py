@@ -158,11 +158,18 @@ def test_scene_renders_a_library_track_and_run_grows_the_tree(browser, ui_url):
     assert pink > 200, "no best path drawn"
     assert metric(page, "nodes") > 100
     assert 9.0 < metric(page, "cost") < 30.0  # 3/4 of a 14 m lap
-    # The profile plots: uPlot canvases with the path drawn in them.
+    # The profile plots: uPlot canvases with the path drawn in them, over numbers (not dates).
     plots = page.locator(".uplot canvas")
-    assert plots.count() >= 3
+    assert plots.count() >= 4
     box = plots.first.bounding_box()
     assert box and box["width"] > 100 and box["height"] > 50
+    assert page.locator(".u-title", has_text="Fastest speed v (m/s) vs s").count() == 1
+    speed = page.locator(".uplot").nth(2)
+    speed.scroll_into_view_if_needed()
+    speed.locator(".u-over").hover(force=True)  # the cursor fills the legend's values
+    legends = " ".join(page.locator(".u-legend").all_inner_texts())
+    assert "s (m)" in legends and "1970" not in legends and not re.search(r"\d(am|pm)", legends)
+    page.screenshot(path=str(ARTIFACTS / "03_profiles.png"))
     page.close()
 
 

@@ -37,6 +37,10 @@ def simulate(
     realtime: Annotated[bool, typer.Option(help="Pace the run to the wall clock.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     log: Annotated[Path | None, typer.Option(help="Write the per-tick log (CSV).")] = None,
+    raceline: Annotated[Path | None, typer.Option(
+        "--raceline", help="Also write the driven path in the TUM raceline layout (the fastest "
+                           "speed along it within the vehicle's max speed, 4 m/s² lateral, "
+                           "2 m/s² longitudinal).")] = None,
 ) -> None:
     """Simulate the car: sense, replan at --rate, track the plan, report the metrics."""
     import planner as core
@@ -54,12 +58,19 @@ def simulate(
                                seed=seed, fixed_latency_ms=fixed_latency,
                                replan=not no_replan, realtime=realtime, laps=laps)
         problem = core.compile_problem(core.load_scenario(scenario))
-        if log is not None and not log.parent.is_dir():
-            raise ValueError(f"--log: directory {str(log.parent)!r} does not exist")
+        for name, out in (("--log", log), ("--raceline", raceline)):
+            if out is not None and not out.parent.is_dir():
+                raise ValueError(f"{name}: directory {str(out.parent)!r} does not exist")
         warm_kernels()
         result = run_simulation(problem.scenario, settings, problem, behaviour=machine)
         if log is not None:
             result.write_log(log)
+        if raceline is not None:
+            from app.raceline import path_raceline, raceline_limits
+
+            driven = result.log[:, [result.columns.index(c) for c in ("x", "y", "theta")]]
+            raceline.write_text(path_raceline(driven, raceline_limits(
+                vehicle=problem.scenario.vehicle)))
     summary = result.summary
     if as_json:
         typer.echo(json.dumps(summary, allow_nan=False, default=_finite))

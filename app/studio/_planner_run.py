@@ -45,13 +45,14 @@ class PlannerRun:
         new track's centreline, for a vehicle of this size."""
         self._view, self._car = None, None
         if self._profiles is not None:
-            for h in (self._profiles.curvature, self._profiles.steering, self._profiles.cost):
+            for h in self._profiles.handles:
                 h.remove()
         prof = track.sample(track.detail_spacing(), vehicle.wheelbase, vehicle.max_steer_deg)
         with self.ui.plots:
             self._profiles = Profiles(self.gui, prof.s, prof.curvature,
                                       goal_fraction(track.closed) * track.length_m,
-                                      vehicle.wheelbase, vehicle.max_steer_deg)
+                                      vehicle.wheelbase, vehicle.max_steer_deg,
+                                      raceline_limits(vehicle=vehicle))
 
     def options(self) -> planner.PlanOptions:
         """The planner panel as `PlanOptions`: 0 in a number field means "derived"."""
