@@ -54,7 +54,7 @@ class Problem:
     @cached_property
     def _pose_clearance(self):
         """`pose_clearance` compiled for this world's types, called past numba's dispatcher:
-        typing a record of 17 arrays costs ~15 µs on every call, the compiled entry ~2 µs,
+        typing a record of 17 arrays on every call makes it ~4.4 µs, the compiled entry ~2.0 µs,
         which matters to callers that check pose by pose (OMPL's validity checker)."""
         pose_clearance(self.world, 0.0, 0.0, 0.0, math.nan)  # compiles (or loads) it
         return pose_clearance.overloads[(typeof(self.world),) + (float64,) * 4].entry_point
