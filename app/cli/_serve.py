@@ -15,9 +15,11 @@ import socket
 import sys
 from pathlib import Path
 from typing import Annotated
+from urllib.parse import quote
 
 import typer
 
+from app.access import Access
 from app.cli._errors import InputError, user_errors
 from app.cli._warm import warm_kernels
 
@@ -43,6 +45,15 @@ def _is_loopback(host: str) -> bool:
         return False
 
 
+def _api_url(host: str, port: int, access: Access) -> str:
+    """The API's base URL for the studio's own calls; with a token, it rides in the URL, so
+    every call sends it (app.access accepts it as a Basic password)."""
+    local = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host)  # the studio calls from here
+    name = f"[{local}]" if ":" in local else local
+    login = f"studio:{quote(access.token, safe='')}@" if access.token else ""
+    return f"http://{login}{name}:{port}/api/v1"
+
+
 async def _run(app, api: socket.socket, host: str, ui: socket.socket) -> None:
     import uvicorn
 
@@ -50,8 +61,9 @@ async def _run(app, api: socket.socket, host: str, ui: socket.socket) -> None:
 
     api_port, ui_port = api.getsockname()[1], ui.getsockname()[1]
     ui.close()  # viser binds it itself; checked free just now
-    local = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host)  # the studio calls from here
-    studio = await asyncio.to_thread(launch, host, ui_port, f"http://{local}:{api_port}/api/v1")
+    access = app.state.settings.access
+    studio = await asyncio.to_thread(launch, host, ui_port, _api_url(host, api_port, access),
+                                     access)
     try:
         if studio.port != ui_port:
             raise InputError(f"studio port {ui_port} on {host} became busy")
@@ -63,6 +75,9 @@ async def _run(app, api: socket.socket, host: str, ui: socket.socket) -> None:
         if server.started:
             print(f"API: http://{host}:{api_port}/docs", flush=True)
             print(f"UI: http://{host}:{ui_port}/", flush=True)
+            if access.token:
+                print(f"Studio with the token: http://{host}:{api_port}/studio?token=<token>",
+                      flush=True)
         await serving
     finally:
         studio.stop()
@@ -80,6 +95,19 @@ def serve(
         help="Where the SQLite database lives [default: the user data directory].")] = None,
     max_upload_mb: Annotated[float, typer.Option(min=0.001, help="Upload limit (MB).")] = 5.0,
     max_plan_s: Annotated[float, typer.Option(min=0.001, help="Longest plan (s).")] = 30.0,
+    token: Annotated[str | None, typer.Option(
+        envvar="TRACKSTAR_TOKEN", show_default=False,
+        help="Require 'Authorization: Bearer TOKEN' on /api/ and a sign-in at "
+             "/studio?token=TOKEN for the studio (prefer the environment variable: a command "
+             "line is visible to other users).")] = None,
+    allowed_hosts: Annotated[list[str] | None, typer.Option(
+        envvar="TRACKSTAR_ALLOWED_HOSTS", show_default=False,
+        help="Host names the server answers to, comma-separated or repeated ('*': any) "
+             "[default: localhost, 127.0.0.1, ::1 and --host].")] = None,
+    allow_origin: Annotated[list[str] | None, typer.Option(
+        envvar="TRACKSTAR_ALLOW_ORIGIN", show_default=False,
+        help="A web origin (https://site.org) allowed to change data and open the studio, "
+             "besides the server's own; repeatable.")] = None,
 ) -> None:
     """Serve the REST API (/docs) and the browser studio; Ctrl-C stops both."""
     import platformdirs
@@ -87,6 +115,12 @@ def serve(
     from app.server import ServerSettings, create_app
 
     with user_errors():
+        if token is not None and (not token.isprintable() or token.strip() != token or not token):
+            raise InputError("--token must be printable, without spaces at its ends")
+        try:
+            access = Access.build(host, allowed_hosts or [], allow_origin or [], token)
+        except ValueError as exc:
+            raise InputError(str(exc)) from None
         api = _listen(host, port, "API")
         try:
             ui = _listen(host, ui_port, "studio")
@@ -97,11 +131,11 @@ def serve(
             raise InputError("the studio and the API need different ports")
         data = data_dir or Path(platformdirs.user_data_dir("trackstar"))
         settings = ServerSettings(data_dir=data, max_upload_mb=max_upload_mb,
-                                  max_plan_s=max_plan_s, ui_port=ui.getsockname()[1])
-        if not _is_loopback(host):
-            print(f"warning: listening on {host}: the studio and the API have no "
-                  "authentication; put them behind a reverse proxy that adds it",
-                  file=sys.stderr, flush=True)
+                                  max_plan_s=max_plan_s, ui_port=ui.getsockname()[1],
+                                  access=access)
+        if not _is_loopback(host) and access.token is None:
+            print(f"warning: listening on {host} without --token: whoever reaches it may use "
+                  "it (docs/server.md: a shared server)", file=sys.stderr, flush=True)
         warm_kernels()  # before the studio and the workers need them: a first start compiles
         # uvicorn re-raises the stop signal once it has shut down; we have already stopped.
         for sig in (signal.SIGINT, signal.SIGTERM):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import asynccontextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib.metadata import version
 from pathlib import Path
 
@@ -14,7 +14,9 @@ from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
 from fastapi_offline import FastAPIOffline
 
+from app.access import Access
 from app.server import (
+    guard,
     routes_jobs,
     routes_plan,
     routes_scenarios,
@@ -39,6 +41,7 @@ class ServerSettings:
     max_plan_s: float = 30.0
     ui_port: int | None = None
     workers: int | None = None  # default: one per CPU available to the process
+    access: Access = field(default_factory=Access)  # who may call (app.access)
 
     @property
     def max_upload_bytes(self) -> int:
@@ -94,6 +97,24 @@ def _scenario_message(error: dict) -> str:
     return f"{where.lstrip('.')}: {error['msg']}"
 
 
+def _document_token(app: FastAPI) -> None:
+    """/docs and /openapi.json stay open (they hold no data); they show the bearer scheme on
+    /api/ so Swagger UI's Authorize button sends the token."""
+    original = app.openapi
+
+    def openapi() -> dict:
+        schema = original()
+        schema.setdefault("components", {})["securitySchemes"] = {
+            "token": {"type": "http", "scheme": "bearer"}}
+        for path, operations in schema["paths"].items():
+            if path.startswith("/api/"):
+                for operation in operations.values():
+                    operation["security"] = [{"token": []}]
+        return schema
+
+    app.openapi = openapi
+
+
 def create_app(settings: ServerSettings) -> FastAPI:
     """The API app; the store and the worker pool live from its startup to its shutdown."""
 
@@ -119,6 +140,9 @@ def create_app(settings: ServerSettings) -> FastAPI:
     )
     app.state.settings = settings
     app.add_middleware(BodyLimit, max_bytes=settings.max_upload_bytes + MULTIPART_SLACK)
+    app.add_middleware(guard.Guard, access=settings.access)  # the outer one: refuses first
+    if settings.access.token is not None:
+        _document_token(app)
 
     @app.exception_handler(RequestValidationError)
     async def invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
@@ -146,6 +170,7 @@ def create_app(settings: ServerSettings) -> FastAPI:
     def landing() -> FileResponse:
         return FileResponse(STATIC / "index.html")
 
+    app.include_router(guard.router)
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
     for module in (routes_tracks, routes_scenarios, routes_plan, routes_jobs, routes_studies,
                    routes_simulations):

@@ -11,6 +11,8 @@ from dataclasses import dataclass, field
 
 import viser
 
+from app.access import Access
+
 __all__ = ["StudioHandle", "launch"]
 
 
@@ -28,9 +30,11 @@ class StudioHandle:
         self.server.stop()
 
 
-def launch(host: str, port: int, api_url: str) -> StudioHandle:
+def launch(host: str, port: int, api_url: str, access: Access | None = None) -> StudioHandle:
     """Start the studio's viser server on (host, port); ``api_url`` is the REST API's base URL
-    (for saving and loading scenarios through the server's store)."""
+    (for saving and loading scenarios through the server's store); ``access`` says which
+    browsers may connect (default: loopback names and ``host``, no token)."""
+    from app.studio._gate import Gate
     from app.studio._session import Session
     from planner.rrt import warm_up
 
@@ -39,6 +43,7 @@ def launch(host: str, port: int, api_url: str) -> StudioHandle:
     server.gui.configure_theme(control_width="large", show_share_button=False)
     server.scene.world_axes.visible = False
     handle = StudioHandle(server=server, port=server.get_port())
+    gate = Gate(server, access or Access.build(host, [], [], None))
     lock = threading.Lock()
 
     def _open(client: viser.ClientHandle) -> None:
@@ -48,6 +53,8 @@ def launch(host: str, port: int, api_url: str) -> StudioHandle:
 
     @server.on_client_connect
     def _connect(client: viser.ClientHandle) -> None:
+        if not gate.admitted(client.client_id):
+            return
         # Off the event loop: building a session (track, meshes, a planner) takes a moment and
         # other tabs must not wait for it.
         threading.Thread(target=_open, args=(client,), daemon=True, name="studio-open").start()
