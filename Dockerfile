@@ -1,5 +1,8 @@
 # Trackstar: REST API (8000) and browser studio (8080) in one process.
 #   docker build -t trackstar . && docker run -p 8000:8000 -p 8080:8080 -v trackstar:/data trackstar
+# It binds 0.0.0.0, so it answers to localhost and 127.0.0.1 only; for a shared server pass the
+# names users type and a token (docs/server.md, "A shared server"):
+#   -e TRACKSTAR_ALLOWED_HOSTS=lab-pc.example.edu -e TRACKSTAR_TOKEN=…
 FROM python:3.11-slim
 
 ENV PYTHONDONTWRITEBYTECODE=1 \
