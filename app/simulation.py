@@ -3,7 +3,8 @@
 `SimOptions` are the options of `trackstar simulate` (same names, same defaults) as the API's
 body fields; `run_simulation` is a plain top-level function so that the server's worker
 processes can run it. It reports progress through a small file the server reads, because a
-pool worker has no other channel back while its call is running.
+pool worker has no other channel back while its call is running; the same way back in, a
+stop file beside it (`request_stop`) ends the run at its next progress write.
 """
 
 from __future__ import annotations
@@ -18,7 +19,8 @@ from pydantic import BaseModel, ConfigDict, Field
 from app.planning import TrackSource, track_loader
 from planner.options import PositiveFinite, Seed
 
-__all__ = ["MAX_DURATION_S", "SimOptions", "read_progress", "run_simulation"]
+__all__ = ["MAX_DURATION_S", "SimOptions", "SimulationStopped", "read_progress",
+           "request_stop", "run_simulation", "stop_path"]
 
 MAX_DURATION_S = 600.0  # simulated seconds per run: a worker is busy for up to about half that
 PROGRESS_EVERY_S = 0.25  # wall time between progress writes
@@ -75,11 +77,28 @@ def run_simulation(scenario, options: SimOptions, track: TrackSource | None,
             partial = progress_path.with_suffix(".tmp")
             partial.write_text(f"{frame.t:.3f}")
             os.replace(partial, progress_path)
+            if stop_path(progress_path).exists():
+                raise SimulationStopped(f"stopped at {frame.t:.1f} s simulated")
 
     run = simulate(problem.scenario, options.settings(), problem, load_track=load_track,
                    observer=progress)
     run.write_log(log_path)
     return run.summary
+
+
+class SimulationStopped(Exception):
+    """A run ended early on request (DELETE /simulations/{id})."""
+
+
+def stop_path(progress_path: Path) -> Path:
+    """The file whose existence asks the run that writes ``progress_path`` to stop."""
+    return progress_path.with_suffix(".stop")
+
+
+def request_stop(progress_path: Path) -> None:
+    """Ask the run to stop: it does within PROGRESS_EVERY_S of wall time plus one control tick
+    (a replan in progress finishes first)."""
+    stop_path(progress_path).touch()
 
 
 def read_progress(progress_path: Path) -> float:

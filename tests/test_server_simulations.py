@@ -21,7 +21,8 @@ THESIS = {"name": "thesis-plain", "track": {"name": "thesis"},
 
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
-    srv = Server(tmp_path_factory.mktemp("data"))
+    srv = Server(data := tmp_path_factory.mktemp("data"))
+    srv.data_dir = data
     yield srv
     srv.stop()
 
@@ -103,3 +104,23 @@ def test_bad_simulations_are_refused(server, body, status, words):
 def test_unknown_simulation_is_404(server):
     assert server.client.get("/simulations/nope").status_code == 404
     assert server.client.get("/simulations/nope/log").status_code == 404
+
+
+def test_delete_stops_a_running_simulation(server):
+    created = server.client.post("/simulations", json={
+        "scenario": THESIS, "laps": 20, "duration": 600, "fixed_latency_ms": 100})
+    sim_id = created.json()["id"]
+    deadline = time.monotonic() + 60
+    while server.client.get(f"/simulations/{sim_id}").json()["sim_time_s"] == 0:
+        assert time.monotonic() < deadline, "the simulation did not start"
+        time.sleep(0.1)
+    stopped = server.client.delete(f"/simulations/{sim_id}")
+    assert stopped.status_code == 200 and stopped.json()["status"] == "cancelled"
+    asked = time.monotonic()
+    files = server.data_dir / "simulations"
+    while list(files.glob(f"{sim_id}.*")):  # the worker's run ended and its task cleaned up
+        assert time.monotonic() - asked < 2.0, list(files.glob(f"{sim_id}.*"))
+        time.sleep(0.05)
+    assert server.client.get(f"/simulations/{sim_id}").json()["status"] == "cancelled"
+    assert server.client.get(f"/simulations/{sim_id}/log").status_code == 409
+    assert server.client.delete("/simulations/nope").status_code == 404

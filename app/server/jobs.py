@@ -18,7 +18,7 @@ from pathlib import Path
 from app.planning import TrackSource, check_scenario, run_plan
 from app.pool import first_line, machine_workers, start_pool, stop_pool
 from app.server.store import Store
-from app.simulation import SimOptions, read_progress, run_simulation
+from app.simulation import SimOptions, read_progress, request_stop, run_simulation, stop_path
 from app.study.report import write_report
 from app.study.results import Results
 from app.study.runner import execute
@@ -108,13 +108,22 @@ class Planning:
     def sim_log(self, sim_id: str) -> Path:
         return self.sim_dir / f"{sim_id}.csv"
 
+    def _progress(self, sim_id: str) -> Path:
+        return self.sim_dir / f"{sim_id}.progress"
+
     def sim_time(self, sim_id: str) -> float:
         """Simulated seconds a running simulation has reached."""
-        return read_progress(self.sim_dir / f"{sim_id}.progress")
+        return read_progress(self._progress(sim_id))
+
+    def cancel_simulation(self, sim_id: str) -> None:
+        """Mark it cancelled and ask its worker to stop (the worker is freed, not killed)."""
+        self.store.set_simulation(sim_id, "cancelled")
+        if sim_id in self._jobs:
+            request_stop(self._progress(sim_id))
 
     async def _simulate(self, sim_id: str, scenario: Scenario, options: SimOptions,
                         track) -> None:
-        progress = self.sim_dir / f"{sim_id}.progress"
+        progress = self._progress(sim_id)
         try:
             self.store.set_simulation(sim_id, "running")
             summary = await self._call(run_simulation, scenario, options, track,
@@ -125,6 +134,7 @@ class Planning:
             self.store.set_simulation(sim_id, "done", summary=summary)
         finally:
             progress.unlink(missing_ok=True)
+            stop_path(progress).unlink(missing_ok=True)
             self._jobs.pop(sim_id, None)
 
     # -- studies: the runs of app.study, each stored in the study's own results directory

@@ -47,6 +47,15 @@ def get_simulation(request: Request, sim_id: str) -> dict:
     return {**sim, "sim_time_s": t, "progress": min(t / sim["settings"]["duration"], 1.0)}
 
 
+@router.delete("/simulations/{sim_id}", response_model=SimulationStatus)
+def cancel_simulation(request: Request, sim_id: str) -> dict:
+    """Stop a queued or running simulation within about a second (status `cancelled`, no
+    log); a finished one is unchanged."""
+    _simulation(request, sim_id)
+    request.app.state.planning.cancel_simulation(sim_id)
+    return get_simulation(request, sim_id)
+
+
 @router.get("/simulations/{sim_id}/log", response_class=FileResponse,
             responses={200: {"content": {"text/csv": {}}}, 409: {}})
 def simulation_log(request: Request, sim_id: str) -> FileResponse:
