@@ -56,11 +56,11 @@ class Access:
     @classmethod
     def build(cls, bound_host: str, hosts: list[str], origins: list[str],
               token: str | None) -> Access:
-        """The policy of `trackstar serve`: without --allowed-hosts, the loopback names and the
-        bound host (unless it is a wildcard address)."""
+        """The policy of `trackstar serve`: the loopback names (the studio's own calls and a
+        health check use them; a rebound DNS name cannot), the bound host unless it is a
+        wildcard address, and the --allowed-hosts."""
         names = {host_name(h) for item in hosts for h in item.split(",") if h.strip()}
-        if not names:
-            names = set(LOOPBACK) | ({host_name(bound_host)} - {"0.0.0.0", "::", ""})
+        names |= set(LOOPBACK) | ({host_name(bound_host)} - {"0.0.0.0", "::", ""})
         netlocs = {origin: _netloc(origin) for origin in origins}
         bad = [origin for origin, netloc in netlocs.items() if netloc is None]
         if bad:

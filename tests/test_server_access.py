@@ -22,7 +22,7 @@ PLAN = {"scenario_id": "slalom", "time": 0.05, "seed": 1}
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
     srv = Server(tmp_path_factory.mktemp("data"), "--allow-origin", COURSE,
-                 "--allowed-hosts", "localhost,127.0.0.1", "--allowed-hosts", "lab.example",
+                 "--allowed-hosts", "lab.example,10.0.0.5", "--allowed-hosts", "lab2.example",
                  env={"TRACKSTAR_TOKEN": TOKEN})
     srv.client.headers["Authorization"] = f"Bearer {TOKEN}"
     yield srv
@@ -60,7 +60,8 @@ def test_writes_from_another_origin_are_refused(server, origin, status):
 
 
 def test_only_allowed_host_names_are_served(server):
-    assert server.get("/health", headers={"Host": f"lab.example:{server.port}"}).status_code == 200
+    for name in ("lab.example", "lab2.example", "10.0.0.5", "localhost"):
+        assert server.get("/health", headers={"Host": f"{name}:{server.port}"}).status_code == 200
     r = server.get("/health", headers={"Host": f"rebound.evil.example:{server.port}"})
     assert r.status_code == 400 and "--allowed-hosts" in r.json()["detail"]
 
@@ -68,6 +69,8 @@ def test_only_allowed_host_names_are_served(server):
 def test_default_hosts_are_loopback_and_the_bound_host():
     assert Access.build("10.1.2.3", [], [], None).hosts == {"localhost", "127.0.0.1", "::1",
                                                             "10.1.2.3"}
+    assert Access.build("0.0.0.0", ["a.example, B.example"], [], None).hosts == {
+        "localhost", "127.0.0.1", "::1", "a.example", "b.example"}
     wildcard = Access.build("0.0.0.0", [], [], None)
     assert wildcard.host_refusal("[::1]:8000") is None
     assert wildcard.host_refusal("0.0.0.0:8000") is not None

@@ -102,8 +102,8 @@ def serve(
              "line is visible to other users).")] = None,
     allowed_hosts: Annotated[list[str] | None, typer.Option(
         envvar="TRACKSTAR_ALLOWED_HOSTS", show_default=False,
-        help="Host names the server answers to, comma-separated or repeated ('*': any) "
-             "[default: localhost, 127.0.0.1, ::1 and --host].")] = None,
+        help="More host names the server answers to, comma-separated or repeated ('*': any); "
+             "it always answers to localhost, 127.0.0.1, ::1 and --host.")] = None,
     allow_origin: Annotated[list[str] | None, typer.Option(
         envvar="TRACKSTAR_ALLOW_ORIGIN", show_default=False,
         help="A web origin (https://site.org) allowed to change data and open the studio, "
