@@ -15,9 +15,11 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, ValidationError, model_validator
 
-from planner.validation import StrictModel, describe, location, suggest
+from planner.validation import StrictModel, Text, describe, location, suggest
 
 __all__ = [
+    "MAX_EXTENT_M",
+    "MAX_WHEELBASE_M",
     "Scenario",
     "ScenarioError",
     "bundled_scenario_path",
@@ -28,14 +30,18 @@ __all__ = [
 ]
 
 LIBRARY = Path(__file__).parent / "scenarios"
+# Physical limits no honest scenario reaches; beyond them the planner's arithmetic overflows.
+MAX_EXTENT_M = 100_000.0  # every coordinate (bounds, poses, points): 100 km from the origin
+MAX_WHEELBASE_M = 100.0
 
 
 class ScenarioError(ValueError):
     """A scenario that cannot be planned, with a one-line message naming the field."""
 
 
-Pose = tuple[float, float, float]
-Point = tuple[float, float]
+Coordinate = Annotated[float, Field(ge=-MAX_EXTENT_M, le=MAX_EXTENT_M)]
+Pose = tuple[Coordinate, Coordinate, Coordinate]
+Point = tuple[Coordinate, Coordinate]
 Positive = Annotated[float, Field(gt=0)]
 
 
@@ -70,7 +76,7 @@ class Vehicle(StrictModel):
     The footprint is a disc of ``radius`` (FORMAT.md) or, in the rich schema, a rectangle.
     """
 
-    wheelbase: Positive = 0.44
+    wheelbase: Annotated[float, Field(gt=0, le=MAX_WHEELBASE_M)] = 0.44
     max_steer_deg: Annotated[float, Field(gt=0, lt=90)] = 26.0
     min_turning_radius: Positive | None = None
     radius: Annotated[float, Field(ge=0)] = 0.0
@@ -175,10 +181,10 @@ class TrackRef(StrictModel):
     scenario drawn or uploaded in the studio is self-contained (``name`` then only labels it).
     ``closed`` reads a CSV as a loop (default) or a road."""
 
-    name: str
+    name: Text
     width_m: Positive | None = None
-    svg: str | None = None
-    csv: str | None = None
+    svg: Text | None = None
+    csv: Text | None = None
     closed: bool | None = None
 
     @model_validator(mode="after")
@@ -196,9 +202,9 @@ class TrackRef(StrictModel):
 class Scenario(StrictModel):
     """A planning problem. Units: metres and radians, except the ``*_deg`` fields."""
 
-    name: str
-    description: str = ""
-    bounds: tuple[float, float, float, float] | None = None
+    name: Text
+    description: Text = ""
+    bounds: tuple[Coordinate, Coordinate, Coordinate, Coordinate] | None = None
     track: TrackRef | None = None
     vehicle: Vehicle = Vehicle()
     start: Pose

@@ -6,11 +6,23 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Iterable
-from typing import Any
+from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, ValidationError, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, ValidationError, model_validator
 
-__all__ = ["StrictModel", "describe", "location", "suggest"]
+__all__ = ["StrictModel", "Text", "describe", "location", "suggest"]
+
+
+def _encodable(text: str) -> str:
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        raise ValueError("must be Unicode text: a lone surrogate (such as \\ud800) is not "
+                         "a character") from None
+    return text
+
+
+Text = Annotated[str, AfterValidator(_encodable)]  # a JSON string that UTF-8 can store
 
 
 def suggest(key: Any, valid: Iterable[str]) -> str:

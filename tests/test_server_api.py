@@ -123,10 +123,39 @@ def test_delete_upload_but_not_library(server):
     (f'<svg {SVG_NS}><text>no paths</text></svg>'.encode(), 400, "no path"),
     (f'<svg {SVG_NS}><path d="M0 0 l{" 1 1" * 20_001}"/></svg>'.encode(), 400, "segments"),
     (b"<svg " + b"x" * 120_000 + b"/>", 413, "limit"),
+    (f'<svg {SVG_NS}>{"<g>" * 2000}<path d="M0 0 L9 0"/>{"</g>" * 2000}</svg>'.encode(), 400,
+     "nested"),
 ])
 def test_bad_uploads_are_refused_with_a_message(server, data, status, words):
     resp = upload(server, data)
     assert resp.status_code == status and words in resp.json()["detail"]
+
+
+def test_a_chunked_upload_above_the_limit_is_413(server):
+    def chunks():  # no Content-Length: httpx sends it chunked
+        yield b"--b\r\nContent-Disposition: form-data; name=file; filename=t.svg\r\n\r\n"
+        for _ in range(40):
+            yield b"x" * 8192
+    resp = server.client.post("/tracks", content=chunks(),
+                              headers={"content-type": "multipart/form-data; boundary=b"})
+    assert resp.status_code == 413 and "limit" in resp.json()["detail"]
+
+
+@pytest.mark.parametrize("change, words", [
+    ({"name": "\ud800"}, "name"),
+    ({"bounds": [-1e308, -1e308, 1e308, 1e308]}, "bounds"),
+    ({"vehicle": {"wheelbase": 1e308}}, "vehicle.wheelbase"),
+    ({"bounds": None, "track": {"name": "nested", "svg": f'<svg {SVG_NS}>{"<g>" * 2000}'
+                                                          f'{"</g>" * 2000}</svg>'}}, "nested"),
+])
+def test_hostile_scenarios_are_4xx_naming_the_field(server, change, words):
+    body = json.dumps(scenario_dict("slalom") | change)  # a lone surrogate: "\ud800"
+    resp = server.client.post("/scenarios", content=body,
+                              headers={"content-type": "application/json"})
+    assert resp.status_code in (400, 422) and words in json.dumps(resp.json()), resp.text
+    plan = server.client.post("/plan", content=f'{{"scenario": {body}, "time": 0.05}}',
+                              headers={"content-type": "application/json"})
+    assert plan.status_code in (400, 422) and words in json.dumps(plan.json()), plan.text
 
 
 def test_upload_options_are_checked(server):

@@ -35,6 +35,7 @@ _CONTAINERS = frozenset({"g", "svg", "a", "switch"})
 _MAX_ELEMENTS = 20_000
 DEFAULT_WIDTH_M = 0.5  # a track drawn with a zero stroke width (a hairline) gets this width
 _MAX_USE_DEPTH = 32
+_MAX_NESTING = 200  # elements inside elements; editors write a few levels, Python's stack ~1000
 # Per document: each segment costs ~0.15 ms to measure, and one takes 1 to 7 numbers, so this
 # bounds a load to a few seconds (counted without parsing, so small files stay fast).
 _MAX_PATH_NUMBERS = 40_000
@@ -114,9 +115,11 @@ class _Walker:
         self.by_id = {e.attrib["id"]: e for e in root.iter() if "id" in e.attrib}
         self.found: list[_Element] = []
 
-    def walk(self, elem, matrix, inherited, clone=None, uses=()) -> None:
+    def walk(self, elem, matrix, inherited, clone=None, uses=(), depth=0) -> None:
         if not elem.tag.startswith(SVG):
             return
+        if depth > _MAX_NESTING:
+            raise TrackError(f"elements nested more than {_MAX_NESTING} deep")
         tag = elem.tag[len(SVG) :]
         props = {**inherited, **_style(elem)}
         if props.get("display") == "none":
@@ -124,14 +127,14 @@ class _Walker:
         props.pop("display", None)
         matrix = matrix @ parse_transform(elem.attrib.get("transform"))
         if tag == "use":
-            self._use(elem, matrix, props, uses)
+            self._use(elem, matrix, props, uses, depth)
         elif tag in _CONTAINERS or (tag == "symbol" and clone is not None):
             for child in elem:
-                self.walk(child, matrix, props, clone, uses)
+                self.walk(child, matrix, props, clone, uses, depth + 1)
         elif tag in SHAPE_TAGS and props.get("visibility", "visible") == "visible":
             self._shape(elem, tag, matrix, props, clone)
 
-    def _use(self, elem, matrix, props, uses) -> None:
+    def _use(self, elem, matrix, props, uses, depth) -> None:
         href = elem.attrib.get(XLINK_HREF) or elem.attrib.get("href") or ""
         target = self.by_id.get(href.removeprefix("#"))
         if target is None or not href.startswith("#"):
@@ -139,7 +142,7 @@ class _Walker:
         if target in uses or len(uses) >= _MAX_USE_DEPTH:
             raise TrackError(f"<use> {elem.attrib.get('id')!r}: clone refers to itself")
         offset = _translate(user_length(elem.attrib.get("x")), user_length(elem.attrib.get("y")))
-        self.walk(target, matrix @ offset, props, elem, (*uses, target))
+        self.walk(target, matrix @ offset, props, elem, (*uses, target), depth + 1)
 
     def _shape(self, elem, tag, matrix, props, clone) -> None:
         data = shape_path_data(tag, elem.attrib)

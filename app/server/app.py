@@ -61,30 +61,32 @@ class BodyLimit:
         length = headers.get(b"content-length", b"0")
         if not length.isdigit() or int(length) > self.max_bytes:
             return await self._refuse(scope, receive, send)
-        seen = 0
+        seen, refused = 0, False
 
         async def limited():
-            nonlocal seen
+            # Answer 413 ourselves and tell the app the client left: an exception raised here
+            # would reach FastAPI's body parsing, which turns any error into a 400.
+            nonlocal seen, refused
             message = await receive()
             seen += len(message.get("body", b""))
-            if seen > self.max_bytes:
-                raise _TooLarge
-            return message
+            if seen <= self.max_bytes:
+                return message
+            if not refused:
+                refused = True
+                await self._refuse(scope, receive, send)
+            return {"type": "http.disconnect"}
 
-        try:
-            await self.app(scope, limited, send)
-        except _TooLarge:
-            await self._refuse(scope, receive, send)
+        async def unless_refused(message) -> None:
+            if not refused:
+                await send(message)
+
+        await self.app(scope, limited, unless_refused)
 
     async def _refuse(self, scope, receive, send) -> None:
         mb = self.max_bytes / 1024 / 1024
         response = JSONResponse({"detail": f"request body above the limit of {mb:.1f} MB "
                                            "(see --max-upload-mb)"}, status_code=413)
         await response(scope, receive, send)
-
-
-class _TooLarge(Exception):
-    pass
 
 
 def _scenario_message(error: dict) -> str:
