@@ -123,7 +123,7 @@ def test_the_dockerfile_cmd_serves_health(tmp_path):
                                              "TRACKSTAR_DATA_DIR": str(tmp_path)})
     try:
         assert srv.lines[-1] == f"UI: http://0.0.0.0:{ui_port}/"
-        assert any("no authentication" in line for line in srv.err)
+        assert any("without --token" in line for line in srv.err)
         health = srv.get("/health").json()
         assert health["status"] == "ok" and health["ui_port"] == ui_port
     finally:
