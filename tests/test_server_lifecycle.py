@@ -9,6 +9,7 @@ import signal
 import socket
 import subprocess
 import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import httpx
@@ -130,19 +131,48 @@ def test_the_dockerfile_cmd_serves_health(tmp_path):
         assert srv.stop() < 5
 
 
-def test_a_dead_worker_is_replaced(tmp_path):
+def pool_workers(srv) -> list[int]:
+    """The server's worker processes, oldest first."""
+    children = Path(f"/proc/{srv.proc.pid}/task/{srv.proc.pid}/children").read_text().split()
+    return sorted(int(pid) for pid in children
+                  if b"spawn_main" in Path(f"/proc/{pid}/cmdline").read_bytes())
+
+
+def test_a_dead_worker_is_replaced_and_only_a_run_that_kills_workers_fails(tmp_path):
     srv = Server(tmp_path)
     try:
-        children = Path(f"/proc/{srv.proc.pid}/task/{srv.proc.pid}/children").read_text().split()
-        workers = [pid for pid in children
-                   if b"spawn_main" in Path(f"/proc/{pid}/cmdline").read_bytes()]
-        assert workers
-        os.kill(int(workers[0]), signal.SIGKILL)
+        os.kill(pool_workers(srv)[0], signal.SIGKILL)  # an idle worker dies (out of memory)
         body = {"scenario": scenario_dict("slalom"), "iterations": 100}
         statuses = [srv.client.post("/plan", json=body) for _ in range(3)]
-        assert {r.status_code for r in statuses} <= {200, 503}
-        assert statuses[-1].status_code == 200
-        failed = [r for r in statuses if r.status_code == 503]
-        assert all("try again" in r.json()["detail"] for r in failed)
+        assert [r.status_code for r in statuses] == [200, 200, 200]
+        # A run whose worker dies mid-plan runs again alone, in a process of its own; when
+        # that one dies too, the run is the cause: 422 for it alone, and the server goes on.
+        with ThreadPoolExecutor(1) as background:
+            crashing = background.submit(srv.client.post, "/plan", json={
+                "scenario": scenario_dict("slalom"), "time": 3.0})
+            time.sleep(1.0)
+            before = pool_workers(srv)
+            os.kill(before[-1] if len(before) == 1 else _busy(before), signal.SIGKILL)
+            deadline = time.monotonic() + 20
+            while len(alone := [p for p in pool_workers(srv) if p > max(before)]) < 3:
+                assert time.monotonic() < deadline, "no new pool and no run alone"
+                time.sleep(0.1)
+            os.kill(max(alone), signal.SIGKILL)  # the run alone: started after the new pool
+            refused = crashing.result(timeout=30)
+        assert refused.status_code == 422, refused.text
+        assert "stops the planning worker that runs it" in refused.json()["detail"]
+        assert any("died twice running run_plan(scenario 'slalom', {" in line
+                   for line in srv.err), srv.err
+        assert srv.client.post("/plan", json=body).status_code == 200
     finally:
         assert srv.stop() < 5
+
+
+def _busy(pids: list[int]) -> int:
+    """The worker that uses the CPU now (the one planning)."""
+    def cpu(pid: int) -> int:
+        return sum(int(v) for v in Path(f"/proc/{pid}/stat").read_text().split()[13:15])
+
+    first = {pid: cpu(pid) for pid in pids}
+    time.sleep(0.3)
+    return max(pids, key=lambda pid: cpu(pid) - first[pid])

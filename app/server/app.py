@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from concurrent.futures.process import BrokenProcessPool
 from contextlib import asynccontextmanager
 from dataclasses import dataclass, field
 from importlib.metadata import version
@@ -24,7 +23,7 @@ from app.server import (
     routes_studies,
     routes_tracks,
 )
-from app.server.jobs import Planning
+from app.server.jobs import Planning, WorkerCrashed
 from app.server.models import INVALID_SCENARIO, Health
 from app.server.store import Store
 from planner import ScenarioError
@@ -159,10 +158,9 @@ def create_app(settings: ServerSettings) -> FastAPI:
     async def unplannable(request: Request, exc: ScenarioError) -> JSONResponse:
         return JSONResponse({"detail": str(exc)}, status_code=422)
 
-    @app.exception_handler(BrokenProcessPool)
-    async def worker_died(request: Request, exc: BrokenProcessPool) -> JSONResponse:
-        return JSONResponse({"detail": "a planning worker stopped (out of memory?); the pool "
-                                       "has been restarted, try again"}, status_code=503)
+    @app.exception_handler(WorkerCrashed)
+    async def worker_crashed(request: Request, exc: WorkerCrashed) -> JSONResponse:
+        return JSONResponse({"detail": str(exc)}, status_code=422)
 
     @app.get("/health", response_model=Health, tags=["server"])
     def health() -> Health:

@@ -5,12 +5,18 @@ compiled kernels once (`warm_up` as its initializer), so no request pays for it.
 the pool at most one run per worker at a time, so a single POST /plan waits for one run, not
 for a whole batch. At shutdown the workers are terminated (a plan may have up to --max-plan-s
 left) and unfinished jobs are marked failed, so a restart shows what was interrupted.
+
+A worker that dies (killed, out of memory, a crash in compiled code) breaks the whole pool and
+every call in flight on it. The pool is replaced and each of those calls runs once more, alone
+in a process of its own: the calls that were only in the way succeed, and the one that kills
+its worker again fails by itself with `WorkerCrashed`, logged with what it was asked to do.
 """
 
 from __future__ import annotations
 
 import asyncio
 import functools
+import logging
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
@@ -27,10 +33,25 @@ from planner.options import PlanOptions
 from planner.report import PlanReport
 from planner.scenario import Scenario
 
-__all__ = ["Planning"]
+__all__ = ["Planning", "WorkerCrashed"]
+
+log = logging.getLogger("trackstar.server")
 
 INTERRUPTED = "interrupted by a server shutdown"
 CRASHED = "interrupted: the server stopped before the job finished"
+
+
+class WorkerCrashed(RuntimeError):
+    """A call that killed its worker twice, the second time alone (HTTP 422)."""
+
+
+def _brief(arg) -> str:
+    """An argument as the crash log shows it: a scenario by name, options as JSON."""
+    name = getattr(arg, "name", None)
+    if isinstance(name, str):
+        return f"scenario {name!r}"
+    dump = getattr(arg, "model_dump_json", None)
+    return dump() if dump is not None else type(arg).__name__
 
 
 class Planning:
@@ -52,14 +73,31 @@ class Planning:
 
     async def _call(self, fn, *args, **kwargs):
         loop = asyncio.get_running_loop()
+        call = functools.partial(fn, *args, **kwargs)
         pool = self.pool
         try:
-            return await loop.run_in_executor(pool, functools.partial(fn, *args, **kwargs))
-        except BrokenProcessPool:  # a worker died (killed, out of memory): replace the pool
+            return await loop.run_in_executor(pool, call)
+        except BrokenProcessPool:  # a worker died with this call in flight: replace the pool
             if self.pool is pool:
                 self.pool = self._start_pool()
                 pool.shutdown(wait=False, cancel_futures=True)
-            raise
+        return await self._alone(call)
+
+    @staticmethod
+    async def _alone(call: functools.partial):
+        """Run ``call`` in a one-worker pool of its own: if it kills that worker too, it is the
+        call that crashes workers, and nothing else goes down with it."""
+        quarantine = start_pool(1)
+        try:
+            return await asyncio.get_running_loop().run_in_executor(quarantine, call)
+        except BrokenProcessPool:
+            log.error("a planning worker died twice running %s(%s)", call.func.__name__,
+                      ", ".join(_brief(a) for a in call.args))
+            raise WorkerCrashed(f"this request stops the planning worker that runs it (twice, "
+                                f"the second time alone): {call.func.__name__} refused; the "
+                                f"server and other requests are not affected") from None
+        finally:
+            quarantine.shutdown(wait=False, cancel_futures=True)
 
     async def check(self, scenario: Scenario, track: TrackSource | None) -> None:
         """Raise ScenarioError unless the scenario compiles (done in a worker: it may be slow)."""
@@ -153,8 +191,11 @@ class Planning:
 
         async def one(run) -> None:
             async with free:
-                outcome, curve = await self._call(execute, study.scenarios[run.scenario], run,
-                                                  self.max_plan_s)
+                try:
+                    outcome, curve = await self._call(execute, study.scenarios[run.scenario],
+                                                      run, self.max_plan_s)
+                except WorkerCrashed as exc:  # stored like any failed run; the others go on
+                    outcome, curve = {"error": first_line(exc)}, []
             results.add(run, outcome, curve)
 
         try:
