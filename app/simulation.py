@@ -17,12 +17,17 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from app.planning import TrackSource, track_loader
-from planner.options import PositiveFinite, Seed
+from planner.options import Seed
 
 __all__ = ["MAX_DURATION_S", "SimOptions", "SimulationStopped", "read_progress",
            "request_stop", "run_simulation", "stop_path"]
 
 MAX_DURATION_S = 600.0  # simulated seconds per run: a worker is busy for up to about half that
+MIN_RATE_HZ, MAX_RATE_HZ = 0.1, 1_000.0  # replanning, control, sensing: 1e12 Hz ran for ever
+MAX_NOISE_M = 100.0  # σ of sensed positions: a sensor that far off senses nothing
+MAX_LATENCY_MS = 60_000.0  # a fixed cycle time of a minute
+
+Rate = Annotated[float, Field(ge=MIN_RATE_HZ, le=MAX_RATE_HZ, allow_inf_nan=False)]
 PROGRESS_EVERY_S = 0.25  # wall time between progress writes
 
 
@@ -33,24 +38,25 @@ class SimOptions(BaseModel):
 
     duration: Annotated[float, Field(gt=0, le=MAX_DURATION_S, allow_inf_nan=False)] = Field(
         60.0, description="simulated seconds at most")
-    rate: PositiveFinite = Field(30.0, description="replanning cycles per second")
-    control_rate: PositiveFinite = Field(100.0, description="control ticks per second")
-    sense_rate: PositiveFinite = Field(10.0, description="sensing instants per second")
+    rate: Rate = Field(30.0, description="replanning cycles per second")
+    control_rate: Rate = Field(100.0, description="control ticks per second")
+    sense_rate: Rate = Field(10.0, description="sensing instants per second")
     controller: Literal["pure-pursuit", "stanley", "pd"] = "pure-pursuit"
-    noise: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+    noise: Annotated[float, Field(ge=0, le=MAX_NOISE_M, allow_inf_nan=False)] = Field(
         0.0, description="σ (m) of sensed positions; the heading gets √2·σ/wheelbase (rad)")
     laps: Annotated[int, Field(ge=1, le=1000)] | None = Field(
         None, description="drive this many laps of the scenario's closed track (rich schema)")
     seed: Seed = 0
-    fixed_latency_ms: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = Field(
+    fixed_latency_ms: Annotated[float, Field(ge=0, le=MAX_LATENCY_MS, allow_inf_nan=False)] | None = Field(
         None, description="a fixed cycle time instead of the measured one (reproducible logs)")
     replan: bool = Field(True, description="false: plan once at t = 0 and follow it blind")
 
-    def settings(self):
-        """The `planner.sim.SimSettings` of these options (raises ValueError when invalid)."""
+    def settings(self, **local):
+        """The `planner.sim.SimSettings` of these options and of ``local`` ones (the command
+        line's ``realtime``)."""
         from planner.sim import SimSettings
 
-        return SimSettings(**self.model_dump())
+        return SimSettings(**self.model_dump(), **local)
 
 
 def run_simulation(scenario, options: SimOptions, track: TrackSource | None,

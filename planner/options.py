@@ -12,7 +12,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from planner.scenario import ScenarioError
+from planner.scenario import ScenarioError, Speed
 from planner.steering import STEERINGS, SteeringName
 
 __all__ = ["METRICS", "PLANNERS", "PlanOptions", "PositiveFinite", "Seed"]
@@ -20,8 +20,13 @@ __all__ = ["METRICS", "PLANNERS", "PlanOptions", "PositiveFinite", "Seed"]
 PLANNERS = ("rrt", "rrtstar")
 METRICS = ("steering", "se2")  # the kernel's codes are their positions
 DEFAULT_TIME_S = 1.0
+# Limits no honest run reaches (the time budget is capped by the server's --max-plan-s).
+MAX_ITERATIONS = 1_000_000  # 50 times the largest budget of the studies; a bigger tree outgrows memory
+MAX_EPS_M = 1_000_000.0  # ε and γ: beyond the diagonal of the largest world (283 km) they change nothing
+MAX_K_RRT = 100.0  # OMPL's 5.5 is the usual; k = k_rrt·log n neighbours each iteration
 
 PositiveFinite = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Length = Annotated[float, Field(gt=0, le=MAX_EPS_M, allow_inf_nan=False)]
 Seed = Annotated[int, Field(ge=0, lt=2**64)]
 
 
@@ -39,14 +44,15 @@ class PlanOptions(BaseModel):
     time: PositiveFinite | None = Field(
         None, description="Time budget in seconds [default: 1.0, or none when an iteration "
                           "budget is given].")
-    iterations: Annotated[int, Field(ge=1)] | None = Field(None, description="Iteration budget.")
+    iterations: Annotated[int, Field(ge=1, le=MAX_ITERATIONS)] | None = Field(
+        None, description="Iteration budget.")
     seed: Seed = Field(0, description="Random seed: same seed, same tree.")
-    eps: PositiveFinite | None = Field(
+    eps: Length | None = Field(
         None, description="Longest extension ε [m] [default: 15 % of the workspace diagonal, "
                           "at least two turning radii].")
-    gamma: PositiveFinite | None = Field(
+    gamma: Length | None = Field(
         None, description="RRT* radius constant γ [default: 2.4 γ* of the free space].")
-    k_rrt: PositiveFinite | None = Field(
+    k_rrt: Annotated[float, Field(gt=0, le=MAX_K_RRT)] | None = Field(
         None, description="RRT* with the k = k_rrt·log n nearest instead of a radius "
                           "(OMPL: 5.5).")
     goal_bias: Annotated[float, Field(ge=0, lt=1)] = Field(
@@ -57,7 +63,7 @@ class PlanOptions(BaseModel):
                                 "planners start with.")
     informed: bool | None = Field(
         None, description="Informed sampling after the first solution [default: on for RRT*].")
-    speed: PositiveFinite | None = Field(
+    speed: Speed | None = Field(
         None, description="Planning speed v [m/s] [default: the scenario's vehicle.speed].")
 
     @property

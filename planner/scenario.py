@@ -19,7 +19,9 @@ from planner.validation import StrictModel, Text, describe, location, suggest
 
 __all__ = [
     "MAX_EXTENT_M",
+    "MAX_SPEED_M_S",
     "MAX_WHEELBASE_M",
+    "MIN_SPEED_M_S",
     "Scenario",
     "ScenarioError",
     "bundled_scenario_path",
@@ -30,9 +32,27 @@ __all__ = [
 ]
 
 LIBRARY = Path(__file__).parent / "scenarios"
-# Physical limits no honest scenario reaches; beyond them the planner's arithmetic overflows.
-MAX_EXTENT_M = 100_000.0  # every coordinate (bounds, poses, points): 100 km from the origin
-MAX_WHEELBASE_M = 100.0
+# Physical limits no honest scenario reaches (a 60 m field of 120 obstacles, a stadium lap, real
+# cars at 30 m/s are far inside); beyond them the planner's arithmetic overflows, its kernels
+# crash or its work has no end. The table with the reasons: docs/server.md#limits.
+MAX_EXTENT_M = 100_000.0  # every coordinate and arc length: 100 km from the origin
+MAX_WHEELBASE_M = 100.0  # longer than any vehicle; 1e308 overflowed ε
+MAX_SIZE_M = 1_000.0  # radii, box sides, track width, goal tolerance, turning radius (1e300 crashed)
+MIN_TURNING_RADIUS_M = 1e-3  # a millimetre: smaller, the steering functions divide by ~0
+MAX_FOOTPRINT_M = 50.0  # a footprint's length, width and overhang: a road train is 50 m
+MAX_FOOTPRINT_DISCS = 100  # ⌈length / width⌉ discs cover it, each checked in every motion
+MAX_SPEED_M_S = 100.0  # the car's and every obstacle's speed (360 km/h); 1e8 planned for ever
+MIN_SPEED_M_S = 1e-3  # the car's planning speed: at 1e-300 a space-time plan never ended
+MAX_ACCEL_M_S2 = 100.0  # 10 g
+MAX_STEER_RATE_DEG_S = 3_600.0  # ten turns of the wheel a second
+MAX_HORIZON_S = 3_600.0  # waypoint times and follow_track horizons: 1e6 s took 1.2 GB
+MAX_OBSTACLES = 10_000  # 100 000 circles took a minute to compile
+MAX_POLYGON_POINTS = 1_000  # per polygon
+MAX_VERTICES = 100_000  # all the polygons' points together
+MAX_WAYPOINTS = 10_000  # per obstacle
+MAX_NAME_CHARS = 200  # a scenario's and a track's name
+MAX_DESCRIPTION_CHARS = 10_000
+MAX_EMBEDDED_CHARS = 10_000_000  # an embedded track file (SVG or CSV)
 
 
 class ScenarioError(ValueError):
@@ -42,7 +62,13 @@ class ScenarioError(ValueError):
 Coordinate = Annotated[float, Field(ge=-MAX_EXTENT_M, le=MAX_EXTENT_M)]
 Pose = tuple[Coordinate, Coordinate, Coordinate]
 Point = tuple[Coordinate, Coordinate]
-Positive = Annotated[float, Field(gt=0)]
+Size = Annotated[float, Field(gt=0, le=MAX_SIZE_M)]
+FootprintSize = Annotated[float, Field(gt=0, le=MAX_FOOTPRINT_M)]
+Speed = Annotated[float, Field(ge=MIN_SPEED_M_S, le=MAX_SPEED_M_S, allow_inf_nan=False)]
+SignedSpeed = Annotated[float, Field(ge=-MAX_SPEED_M_S, le=MAX_SPEED_M_S)]  # an obstacle's
+Time = Annotated[float, Field(ge=-MAX_HORIZON_S, le=MAX_HORIZON_S)]
+Name = Annotated[Text, Field(max_length=MAX_NAME_CHARS)]
+Embedded = Annotated[Text, Field(max_length=MAX_EMBEDDED_CHARS)]
 
 
 class Footprint(StrictModel):
@@ -50,9 +76,21 @@ class Footprint(StrictModel):
     reference point — ``rear_overhang`` metres in front of the rear bumper."""
 
     type: Literal["rectangle"]
-    length: Positive
-    width: Positive
-    rear_overhang: Annotated[float, Field(ge=0)] | None = None
+    length: FootprintSize
+    width: FootprintSize
+    rear_overhang: Annotated[float, Field(ge=0, le=MAX_FOOTPRINT_M)] | None = None
+
+    @model_validator(mode="after")
+    def _few_discs(self) -> Footprint:
+        if self.disc_count > MAX_FOOTPRINT_DISCS:
+            raise ValueError(f"length / width = {self.length / self.width:.6g} needs "
+                             f"{self.disc_count} discs, at most {MAX_FOOTPRINT_DISCS}")
+        return self
+
+    @property
+    def disc_count(self) -> int:
+        """n = ⌈length / width⌉: the discs that cover the rectangle."""
+        return max(1, math.ceil(self.length / self.width - 1e-9))
 
     def overhang(self, wheelbase: float) -> float:
         """The rear overhang: as given, else the wheelbase centred in the length."""
@@ -64,7 +102,7 @@ class Footprint(StrictModel):
         """Cover the rectangle exactly by n = ⌈length / width⌉ equal discs along its axis:
         (offset from the rear axle along the heading, radius) rows."""
         overhang = self.overhang(wheelbase)
-        n = max(1, math.ceil(self.length / self.width - 1e-9))
+        n = self.disc_count
         half = self.length / (2 * n)
         radius = math.hypot(half, self.width / 2)
         return [(-overhang + half * (2 * i + 1), radius) for i in range(n)]
@@ -78,20 +116,25 @@ class Vehicle(StrictModel):
 
     wheelbase: Annotated[float, Field(gt=0, le=MAX_WHEELBASE_M)] = 0.44
     max_steer_deg: Annotated[float, Field(gt=0, lt=90)] = 26.0
-    min_turning_radius: Positive | None = None
-    radius: Annotated[float, Field(ge=0)] = 0.0
+    min_turning_radius: Annotated[float, Field(ge=MIN_TURNING_RADIUS_M, le=MAX_SIZE_M)] | None \
+        = None
+    radius: Annotated[float, Field(ge=0, le=MAX_SIZE_M)] = 0.0
     footprint: Footprint | None = None
-    speed: Positive = 1.0
-    max_speed: Positive | None = None
-    max_accel: Positive = 1.0
-    max_steer_rate_deg_s: Positive = 180.0
+    speed: Speed = 1.0
+    max_speed: Speed | None = None
+    max_accel: Annotated[float, Field(gt=0, le=MAX_ACCEL_M_S2)] = 1.0
+    max_steer_rate_deg_s: Annotated[float, Field(gt=0, le=MAX_STEER_RATE_DEG_S)] = 180.0
 
     @model_validator(mode="after")
-    def _speeds(self) -> Vehicle:
+    def _consistent(self) -> Vehicle:
         if self.max_speed is not None and self.max_speed < self.speed:
             raise ValueError(f"max_speed ({self.max_speed}) is below speed ({self.speed})")
         if self.footprint is not None and self.radius > 0:
             raise ValueError("give either 'radius' (a disc) or 'footprint', not both")
+        if not MIN_TURNING_RADIUS_M <= self.turning_radius <= MAX_SIZE_M:
+            raise ValueError(f"the turning radius wheelbase / tan(max_steer_deg) = "
+                             f"{self.turning_radius:.6g} m is outside "
+                             f"[{MIN_TURNING_RADIUS_M}, {MAX_SIZE_M}] m")
         return self
 
     def discs(self) -> list[tuple[float, float]]:
@@ -109,15 +152,16 @@ class Vehicle(StrictModel):
 
 
 class GoalTolerance(StrictModel):
-    position: Annotated[float, Field(gt=0)] = 0.25
+    position: Size = 0.25
     heading_deg: Annotated[float, Field(gt=0, le=180)] = 20.0
 
 
 class Motion(StrictModel):
     """Exactly one of: constant velocity, timed waypoints, or following a library track."""
 
-    velocity: Point | None = None
-    waypoints: list[tuple[float, float, float]] | None = None
+    velocity: tuple[SignedSpeed, SignedSpeed] | None = None
+    waypoints: Annotated[list[tuple[Time, Coordinate, Coordinate]],
+                         Field(max_length=MAX_WAYPOINTS)] | None = None
     follow_track: FollowTrack | None = None
 
     @model_validator(mode="after")
@@ -132,27 +176,38 @@ class Motion(StrictModel):
             times = [w[0] for w in self.waypoints]
             if any(b <= a for a, b in zip(times, times[1:])):
                 raise ValueError(f"waypoint times must be strictly increasing, got {times}")
+        if self.speed > MAX_SPEED_M_S:
+            raise ValueError(f"moves at {self.speed:.6g} m/s, at most {MAX_SPEED_M_S} m/s")
         return self
+
+    @property
+    def speed(self) -> float:
+        """The fastest speed of the motion in m/s: the velocity's, or between two waypoints
+        (a track follower's speed is checked by its field)."""
+        if self.velocity is not None:
+            return math.hypot(*self.velocity)
+        return max((math.hypot(x1 - x0, y1 - y0) / (t1 - t0) for (t0, x0, y0), (t1, x1, y1)
+                    in zip(self.waypoints or [], (self.waypoints or [])[1:])), default=0.0)
 
 
 class FollowTrack(StrictModel):
     """Drive along the scenario's track centreline at ``speed`` from arc length ``start_s``."""
 
-    speed: float
-    start_s: float = 0.0
-    horizon_s: Positive = 120.0
+    speed: SignedSpeed
+    start_s: Coordinate = 0.0
+    horizon_s: Annotated[float, Field(gt=0, le=MAX_HORIZON_S)] = 120.0
 
 
 class Circle(StrictModel):
     type: Literal["circle"]
     center: Point
-    radius: Positive
+    radius: Size
     motion: Motion | None = None
 
 
 class Polygon(StrictModel):
     type: Literal["polygon"]
-    points: Annotated[list[Point], Field(min_length=3)]
+    points: Annotated[list[Point], Field(min_length=3, max_length=MAX_POLYGON_POINTS)]
     motion: Motion | None = None
 
 
@@ -161,7 +216,7 @@ class Box(StrictModel):
 
     type: Literal["box"]
     center: Point
-    size: tuple[Positive, Positive]
+    size: tuple[Size, Size]
     angle_deg: float = 0.0
     motion: Motion | None = None
 
@@ -181,10 +236,10 @@ class TrackRef(StrictModel):
     scenario drawn or uploaded in the studio is self-contained (``name`` then only labels it).
     ``closed`` reads a CSV as a loop (default) or a road."""
 
-    name: Text
-    width_m: Positive | None = None
-    svg: Text | None = None
-    csv: Text | None = None
+    name: Name
+    width_m: Size | None = None
+    svg: Embedded | None = None
+    csv: Embedded | None = None
     closed: bool | None = None
 
     @model_validator(mode="after")
@@ -202,15 +257,15 @@ class TrackRef(StrictModel):
 class Scenario(StrictModel):
     """A planning problem. Units: metres and radians, except the ``*_deg`` fields."""
 
-    name: Text
-    description: Text = ""
+    name: Name
+    description: Annotated[Text, Field(max_length=MAX_DESCRIPTION_CHARS)] = ""
     bounds: tuple[Coordinate, Coordinate, Coordinate, Coordinate] | None = None
     track: TrackRef | None = None
     vehicle: Vehicle = Vehicle()
     start: Pose
     goal: Pose
     goal_tolerance: GoalTolerance = GoalTolerance()
-    obstacles: list[Obstacle] = []
+    obstacles: Annotated[list[Obstacle], Field(max_length=MAX_OBSTACLES)] = []
 
     @model_validator(mode="after")
     def _region(self) -> Scenario:
@@ -224,6 +279,10 @@ class Scenario(StrictModel):
         for i, ob in enumerate(self.obstacles):
             if ob.motion and ob.motion.follow_track and self.track is None:
                 raise ValueError(f"obstacles[{i}].motion.follow_track needs a 'track'")
+        vertices = sum(len(ob.points) for ob in self.obstacles if isinstance(ob, Polygon))
+        if vertices > MAX_VERTICES:
+            raise ValueError(f"obstacles: the polygons have {vertices} points together, "
+                             f"at most {MAX_VERTICES}")
         return self
 
     @property

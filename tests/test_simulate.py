@@ -234,7 +234,7 @@ def _with(tmp_path, name="crossing", **changes):
 
 @pytest.mark.parametrize("args, needle", [
     (["--rate", "0"], "--rate"), (["--duration", "-1"], "--duration"),
-    (["--control-rate", "nan"], "--control-rate"), (["--controller", "lqr"], "lqr"),
+    (["--control-rate", "nan"], "--control-rate"), (["--controller", "lqr"], "--controller"),
     (["--sense-rate", "0"], "--sense-rate"),
 ])
 def test_cli_rejects_bad_options(args, needle):

@@ -44,7 +44,7 @@ def simulate(
 ) -> None:
     """Simulate the car: sense, replan at --rate, track the plan, report the metrics."""
     import planner as core
-    from planner.sim import SimSettings
+    from app.simulation import SimOptions
     from planner.sim import simulate as run_simulation
 
     with user_errors():
@@ -53,10 +53,10 @@ def simulate(
             from planner.sim.fsm import load_fsm
 
             machine = load_fsm(behaviour)  # a bad file is reported first, naming the element
-        settings = SimSettings(duration=duration, rate=rate, control_rate=control_rate,
-                               sense_rate=sense_rate, controller=controller, noise=noise,
-                               seed=seed, fixed_latency_ms=fixed_latency,
-                               replan=not no_replan, realtime=realtime, laps=laps)
+        settings = SimOptions(duration=duration, rate=rate, control_rate=control_rate,
+                              sense_rate=sense_rate, controller=controller, noise=noise,
+                              seed=seed, fixed_latency_ms=fixed_latency, replan=not no_replan,
+                              laps=laps).settings(realtime=realtime)
         problem = core.compile_problem(core.load_scenario(scenario))
         for name, out in (("--log", log), ("--raceline", raceline)):
             if out is not None and not out.parent.is_dir():
