@@ -8,6 +8,7 @@ one, so a typo fails loudly instead of silently meaning a default.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from pathlib import Path
@@ -187,7 +188,7 @@ class Motion(StrictModel):
         if self.velocity is not None:
             return math.hypot(*self.velocity)
         return max((math.hypot(x1 - x0, y1 - y0) / (t1 - t0) for (t0, x0, y0), (t1, x1, y1)
-                    in zip(self.waypoints or [], (self.waypoints or [])[1:])), default=0.0)
+                    in itertools.pairwise(self.waypoints or [])), default=0.0)
 
 
 class FollowTrack(StrictModel):
@@ -265,7 +266,7 @@ class Scenario(StrictModel):
     start: Pose
     goal: Pose
     goal_tolerance: GoalTolerance = GoalTolerance()
-    obstacles: Annotated[list[Obstacle], Field(max_length=MAX_OBSTACLES)] = []
+    obstacles: list[Obstacle] = Field([], max_length=MAX_OBSTACLES)
 
     @model_validator(mode="after")
     def _region(self) -> Scenario:

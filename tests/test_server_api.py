@@ -145,6 +145,10 @@ def test_a_chunked_upload_above_the_limit_is_413(server):
     ({"name": "\ud800"}, "name"),
     ({"bounds": [-1e308, -1e308, 1e308, 1e308]}, "bounds"),
     ({"vehicle": {"wheelbase": 1e308}}, "vehicle.wheelbase"),
+    ({"obstacles": [{"type": "circle", "center": [1, 1], "radius": 0.1,
+                     "motion": {"velocity": [1e8, 0]}}]}, "less than or equal to 100"),
+    ({"vehicle": {"footprint": {"type": "rectangle", "length": 1e300, "width": 1e-300}}},
+     "vehicle.footprint.length"),
     ({"bounds": None, "track": {"name": "nested", "svg": f'<svg {SVG_NS}>{"<g>" * 2000}'
                                                           f'{"</g>" * 2000}</svg>'}}, "nested"),
 ])

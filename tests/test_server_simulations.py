@@ -87,6 +87,7 @@ def test_laps_of_a_stored_scenario_with_progress(server):
     ({"scenario": THESIS, "laps": 0}, 422, "greater than or equal to 1"),
     ({"scenario": THESIS, "duration": 0}, 422, "greater than 0"),
     ({"scenario": THESIS, "duration": 1e6}, 422, "less than or equal to 600"),
+    ({"scenario": THESIS, "control_rate": 1e12}, 422, "less than or equal to 1000"),
     ({"scenario": THESIS, "controller": "lqr"}, 422, "pure-pursuit"),
     ({"scenario": THESIS, "seeds": [1]}, 422, "Extra inputs"),
     ({"scenario": THESIS, "scenario_id": "x"}, 422, "exactly one of"),
