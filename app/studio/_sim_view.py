@@ -12,14 +12,17 @@ steering and lateral error plots and the metrics.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import threading
 import time
 from dataclasses import dataclass
 
 import numpy as np
+from pydantic import ValidationError
 
 import planner
+from app.simulation import SimOptions
 from app.studio._live_view import PATH_RGB, TREE_RGB
 from app.studio._scene import (
     Z,
@@ -34,6 +37,7 @@ from planner.sim import SimSettings
 from planner.sim.control import CONTROLLERS
 from planner.sim.run import Frame, simulate
 from planner.sim.sensing import mover_index
+from planner.validation import describe
 
 __all__ = ["SimControls", "SimView", "build_controls"]
 
@@ -173,10 +177,15 @@ class SimView:
 
     # -- commands ------------------------------------------------------------------------------
     def settings(self) -> SimSettings:
-        """The folder's settings (ValueError when they are not valid)."""
+        """The folder's settings, within the limits of `trackstar simulate` (one ValueError
+        line naming the field when not)."""
         u = self.ui
-        return SimSettings(rate=float(u.rate.value), controller=u.controller.value,
-                           noise=float(u.noise.value), seed=int(u.seed.value), realtime=True)
+        try:
+            options = SimOptions(rate=float(u.rate.value), controller=u.controller.value,
+                                 noise=float(u.noise.value), seed=int(u.seed.value))
+        except ValidationError as exc:
+            raise ValueError(describe(exc)) from None
+        return dataclasses.replace(options.settings(), realtime=True)
 
     def start(self, problem, settings: SimSettings) -> None:
         """A new run of ``problem`` (the caller keeps the planner's own run out of its way)."""
