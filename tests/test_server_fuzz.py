@@ -21,7 +21,7 @@ JSON = st.recursive(
 KEYS = st.sampled_from(["name", "bounds", "start", "goal", "vehicle", "obstacles", "track",
                         "goal_tolerance", "radius", "center", "points", "motion", "type",
                         "wheelbase", "max_steer_deg", "velocity", "waypoints", "size", "speed"])
-FUZZ = settings(max_examples=60, deadline=None, derandomize=True,
+FUZZ = settings(max_examples=40, deadline=None, derandomize=True,
                 suppress_health_check=[HealthCheck.function_scoped_fixture,
                                        HealthCheck.too_slow])
 

@@ -11,7 +11,7 @@ import pytest
 import planner
 from planner.sim import SimSettings, simulate
 
-SETTINGS = SimSettings(duration=8.0, fixed_latency_ms=20.0, seed=3)
+SETTINGS = SimSettings(duration=4.0, fixed_latency_ms=20.0, seed=3)
 
 
 @pytest.fixture(scope="module")

@@ -168,7 +168,7 @@ def test_laps_without_a_track_is_exit_2_with_one_line():
     assert r.stderr.strip().count("\n") == 0
     assert "--laps needs a scenario with a closed track" in r.stderr
     r = _cli("thesis_half_lap", "--laps", 0)
-    assert r.returncode == 2 and "--laps must be at least 1" in r.stderr, r.stderr
+    assert r.returncode == 2 and "--laps: Input should be greater than or equal to 1" in r.stderr, r.stderr
 
 
 def test_the_first_plan_is_not_a_replan():

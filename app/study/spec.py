@@ -185,11 +185,9 @@ class StudyFile(StrictModel):
         return self
 
     @model_validator(mode="after")
-    def _ompl_can_run(self) -> StudyFile:
-        """OMPL's targets need the bench extra, and plan Dubins or Reeds-Shepp only."""
+    def _ompl_steering(self) -> StudyFile:
+        """OMPL's targets plan Dubins or Reeds-Shepp only."""
         ompl = [p for p in self.planners or () if p in OMPL_PLANNERS]
-        if ompl and not ompl_bridge.available():
-            raise ValueError(f"planners: {ompl[0]} needs OMPL: pip install 'trackstar[bench]'")
         other = [s for s in self.steering or () if s not in STEERING_SPACES]
         if ompl and other:
             raise ValueError(f"steering: {ompl[0]} plans {' or '.join(STEERING_SPACES)} only, "
@@ -308,6 +306,9 @@ def parse_study(data: Any, text: str, resolve: Callable[[Any], planner.Scenario]
                              f"which OMPL's planners cannot plan; leave out the ompl: "
                              f"planners or this scenario")
         scenarios.setdefault(scenario.name, scenario)
+    ompl = [p for p in spec.planners or () if p in OMPL_PLANNERS]
+    if ompl and not ompl_bridge.available():  # last: a file with other errors names those
+        raise StudyError(f"{lead}planners: {ompl[0]} needs OMPL: pip install 'trackstar[bench]'")
     return Study(spec.name, spec.kind, text, scenarios, _runs(spec, list(scenarios)))
 
 
