@@ -16,8 +16,10 @@ import test_studio_browser as sb
 import planner
 
 pytestmark = sb.pytestmark
-# The studio browser tests' fixtures: its server (ui_url, and urls where it has them) and chromium.
-globals().update({k: getattr(sb, k) for k in ("urls", "ui_url", "browser") if hasattr(sb, k)})
+# The studio browser tests' fixtures: its server (ui_url, and urls where it has them), chromium
+# and the closing of every tab after a test.
+globals().update({k: getattr(sb, k) for k in ("urls", "ui_url", "browser", "close_tabs")
+                  if hasattr(sb, k)})
 
 PATH_RGB = (255, 90, 200)  # the committed path (app/studio/_live_view.py)
 
