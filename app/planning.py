@@ -6,6 +6,9 @@ It is a plain top-level function so that the server's worker processes can run i
 
 from __future__ import annotations
 
+import time
+from collections.abc import Callable
+
 from pydantic import BaseModel
 
 from planner.options import PlanOptions
@@ -52,17 +55,29 @@ def check_scenario(scenario, track: TrackSource | None = None) -> None:
 
 
 def run_plan(scenario, options: PlanOptions, *, max_time: float | None = None,
-             track: TrackSource | None = None) -> PlanReport:
+             track: TrackSource | None = None,
+             stop: Callable[[], bool] | None = None) -> PlanReport:
     """Plan a scenario (a `planner.Scenario` or its JSON object) and report the result.
 
-    Raises `planner.ScenarioError` (a ValueError) for scenarios that cannot be planned and
-    ValueError for bad options, each with a message that names the problem.
+    The time budget covers compiling the scenario too, so a run ends within it (plus at most
+    one planner iteration); ``stop()`` ends planning early, e.g. when the client has gone.
+    Raises `planner.ScenarioError` (a ValueError) for scenarios that cannot be planned, or
+    whose compiling alone takes the whole time budget, and ValueError for bad options, each
+    with a message that names the problem.
     """
     import planner as core
     from planner.report import plan_report
 
-    budget_time = options.time_budget(max_time)
+    budget_time = planning_time = options.time_budget(max_time)
+    started = time.perf_counter()
     problem = _compile(scenario, track)
-    result = core.Planner(problem, options).solve(budget_time, options.iterations)
+    if budget_time is not None:
+        compiling = time.perf_counter() - started
+        if compiling >= budget_time:
+            raise core.ScenarioError(
+                f"compiling the scenario took {compiling:.2f} s, the whole time budget of "
+                f"{budget_time:g} s: give more time")
+        planning_time -= compiling
+    result = core.Planner(problem, options).solve(planning_time, options.iterations, stop)
     return plan_report(result, problem.scenario.name,
                        {"time": budget_time, "iterations": options.iterations})

@@ -3,7 +3,7 @@
 Each worker loads the planner's compiled kernels once (its initializer), leaves Ctrl-C to its
 parent (which terminates it) and ends with its parent even when that is killed with -9 (nothing
 could terminate it then). Workers are spawned, not forked: the parent may run threads (uvicorn,
-viser, sqlite).
+viser, sqlite). A call that is running can be asked to stop through a `StopFlag`.
 """
 
 from __future__ import annotations
@@ -14,8 +14,9 @@ import signal
 import threading
 import time
 from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
 
-__all__ = ["first_line", "machine_workers", "start_pool", "stop_pool"]
+__all__ = ["StopFlag", "first_line", "machine_workers", "start_pool", "stop_pool"]
 
 PARENT_POLL_S = 0.5
 
@@ -54,6 +55,23 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
         process.terminate()
     for process in processes:
         process.join(2.0)
+
+
+class StopFlag:
+    """Asks a call running in a worker to stop: a file that the caller creates and the call
+    looks for between batches of its work (a busy worker has no other way in). Picklable."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def __call__(self) -> bool:
+        return self.path.exists()
+
+    def set(self) -> None:
+        self.path.touch()
+
+    def clear(self) -> None:
+        self.path.unlink(missing_ok=True)
 
 
 def first_line(exc: BaseException) -> str:

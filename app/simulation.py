@@ -3,14 +3,15 @@
 `SimOptions` are the options of `trackstar simulate` (same names, same defaults) as the API's
 body fields; `run_simulation` is a plain top-level function so that the server's worker
 processes can run it. It reports progress through a small file the server reads, because a
-pool worker has no other channel back while its call is running; the same way back in, a
-stop file beside it (`request_stop`) ends the run at its next progress write.
+pool worker has no other channel back while its call is running; the way in is its
+`app.pool.StopFlag`, looked at with each progress write.
 """
 
 from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -20,7 +21,7 @@ from app.planning import TrackSource, track_loader
 from planner.options import Seed
 
 __all__ = ["MAX_DURATION_S", "SimOptions", "SimulationStopped", "read_progress",
-           "request_stop", "run_simulation", "stop_path"]
+           "run_simulation"]
 
 MAX_DURATION_S = 600.0  # simulated seconds per run: a worker is busy for up to about half that
 MIN_RATE_HZ, MAX_RATE_HZ = 0.1, 1_000.0  # replanning, control, sensing: 1e12 Hz ran for ever
@@ -60,12 +61,15 @@ class SimOptions(BaseModel):
 
 
 def run_simulation(scenario, options: SimOptions, track: TrackSource | None,
-                   log_path: Path, progress_path: Path) -> dict:
+                   log_path: Path, progress_path: Path,
+                   stop: Callable[[], bool] | None = None) -> dict:
     """Simulate a scenario (a `planner.Scenario` or its JSON object), write the per-tick log CSV
     to ``log_path`` and return the JSON summary.
 
     While running, the simulated time reached is written to ``progress_path`` about every
-    quarter second of wall time (replaced atomically, so a reader never sees half a number).
+    quarter second of wall time (replaced atomically, so a reader never sees half a number),
+    and the run ends with `SimulationStopped` if ``stop()`` is true by then; the file is gone
+    when the run has ended.
     """
     import planner as core
     from planner.sim import simulate
@@ -83,28 +87,20 @@ def run_simulation(scenario, options: SimOptions, track: TrackSource | None,
             partial = progress_path.with_suffix(".tmp")
             partial.write_text(f"{frame.t:.3f}")
             os.replace(partial, progress_path)
-            if stop_path(progress_path).exists():
+            if stop is not None and stop():
                 raise SimulationStopped(f"stopped at {frame.t:.1f} s simulated")
 
-    run = simulate(problem.scenario, options.settings(), problem, load_track=load_track,
-                   observer=progress)
+    try:
+        run = simulate(problem.scenario, options.settings(), problem, load_track=load_track,
+                       observer=progress)
+    finally:
+        progress_path.unlink(missing_ok=True)
     run.write_log(log_path)
     return run.summary
 
 
 class SimulationStopped(Exception):
     """A run ended early on request (DELETE /simulations/{id})."""
-
-
-def stop_path(progress_path: Path) -> Path:
-    """The file whose existence asks the run that writes ``progress_path`` to stop."""
-    return progress_path.with_suffix(".stop")
-
-
-def request_stop(progress_path: Path) -> None:
-    """Ask the run to stop: it does within PROGRESS_EVERY_S of wall time plus one control tick
-    (a replan in progress finishes first)."""
-    stop_path(progress_path).touch()
 
 
 def read_progress(progress_path: Path) -> float:

@@ -24,6 +24,9 @@ from numba import njit
 from planner._paths import TURN, advance
 
 CONTACT = 1e-4
+# Distance evaluations that filling the clearance grid may take (~1 s): a crowded scene gets
+# coarser cells instead of a compile without end (10 000 circles took 46 s at full size).
+GRID_WORK = 1e8
 # Indices into World.geo.
 XMIN, YMIN, XMAX, YMAX, RADIUS, VMAX_OBS, HAS_REGION, REACH = range(8)
 STATIC, VELOCITY, WAYPOINTS = 0, 1, 2
@@ -98,7 +101,10 @@ def build_world(bounds, radius, circles, polygons, motions, rings=(), centreline
     geo = np.array([*bounds, discs[:, 1].min(), vmax, 1.0 if len(ring_edges) else 0.0,
                     np.abs(discs[:, 0]).max()], dtype=float)
     xmin, ymin, xmax, ymax = bounds
-    h = max(math.hypot(xmax - xmin, ymax - ymin) / 500.0, 0.01)
+    per_cell = (1 + (circ_motion < 0).sum() + ring_edges.shape[0]
+                + sum(len(p) for p, (_, m) in zip(pts, polygons) if m < 0))
+    h = max(math.hypot(xmax - xmin, ymax - ymin) / 500.0, 0.01,
+            math.sqrt((xmax - xmin) * (ymax - ymin) * per_cell / GRID_WORK))
     nx, ny = math.ceil((xmax - xmin) / h), math.ceil((ymax - ymin) / h)
     world = World(geo, discs, circ, circ_motion, poly_edges, poly_start, poly_bbox, poly_motion,
                   ring_edges, m_kind, m_vel, m_wp_start, m_wp, np.zeros((nx, ny)),
@@ -177,6 +183,8 @@ def _point_obstacles(w: World, x: float, y: float, t: float, moving: bool, c: fl
             ox, oy = offset(w, m, t)
             cx += ox
             cy += oy
+        if max(abs(x - cx), abs(y - cy)) - w.circ[i, 2] >= c:
+            continue  # this circle cannot be nearer than what we have
         d = math.hypot(x - cx, y - cy) - w.circ[i, 2]
         if d < c:
             c = d

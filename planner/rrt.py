@@ -204,16 +204,20 @@ class Planner:
             if clock.first_solution_s is None:
                 clock.first_solution_s = when
 
-    def solve(self, time_limit: float | None = 1.0, iterations: int | None = None) -> Result:
-        """Run until the time or iteration budget is spent (RRT: until the first solution)."""
+    def solve(self, time_limit: float | None = 1.0, iterations: int | None = None,
+              stop: Callable[[], bool] | None = None) -> Result:
+        """Run until the time or iteration budget is spent (RRT: until the first solution) or
+        ``stop()`` is true (asked between batches of about 2 ms)."""
         if time_limit is None and iterations is None:
             raise ValueError("give a time limit, an iteration budget, or both")
         warm_up()
-        batch = 16
+        batch = 1  # then sized from the first: a slow scene passes its deadline by one at most
         limit = math.inf if time_limit is None else time_limit
         max_iter = math.inf if iterations is None else self.iterations + iterations
         start = self._compute_time
         while self._compute_time - start < limit and self.iterations < max_iter:
+            if stop is not None and stop():
+                break
             n = int(min(batch, max_iter - self.iterations))
             t0 = time.perf_counter()
             self.step(n)

@@ -71,3 +71,16 @@ class Server:
                 return job
             time.sleep(0.1)
         raise TimeoutError(f"job {job_id} still {job['status']} after {timeout} s")
+
+    def workers_cpu_s(self) -> float:
+        """CPU seconds used so far by the server's child processes (its planning workers)."""
+        tick = os.sysconf("SC_CLK_TCK")
+        total = 0
+        for stat in Path("/proc").glob("[0-9]*/stat"):
+            try:
+                fields = stat.read_text().rsplit(")", 1)[1].split()
+            except OSError:  # the process has ended meanwhile
+                continue
+            if int(fields[1]) == self.proc.pid:  # its parent
+                total += int(fields[11]) + int(fields[12])  # utime, stime
+        return total / tick

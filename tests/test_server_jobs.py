@@ -6,6 +6,7 @@ import csv
 import io
 import time
 
+import httpx
 import pytest
 from _server import Server
 from conftest import scenario_dict
@@ -95,3 +96,25 @@ def test_server_answers_while_the_pool_is_busy(server):
     assert server.client.get(f"/jobs/{job_id}").json()["status"] == "running"
     assert sorted(latencies)[10] < 0.1, latencies  # the median: robust to a loaded runner
     server.client.delete(f"/jobs/{job_id}")
+
+
+def test_delete_and_a_client_that_gives_up_stop_their_plans_in_the_workers(server):
+    """Two 20 s runs hold both workers until DELETE; then two 20 s plans whose clients give up
+    after a second. Each time the workers are free again at once: a short plan answers."""
+    def quick_plan_s() -> float:
+        start = time.monotonic()
+        plan = server.client.post("/plan", json={"scenario_id": "slalom", "time": 0.1})
+        assert plan.status_code == 200, plan.text
+        return time.monotonic() - start
+
+    long_runs = {"scenarios": [scenario_dict("slalom")], "parameters": [{"time": 20.0}],
+                 "seeds": [0, 1]}
+    job_id = server.client.post("/jobs", json=long_runs).json()["id"]
+    time.sleep(1.0)
+    server.client.delete(f"/jobs/{job_id}")
+    assert quick_plan_s() < 5.0
+    for _ in range(2):
+        with pytest.raises(httpx.ReadTimeout):
+            server.client.post("/plan", json={"scenario_id": "slalom", "time": 20.0},
+                               timeout=1.0)
+    assert quick_plan_s() < 5.0

@@ -176,3 +176,25 @@ def _busy(pids: list[int]) -> int:
     first = {pid: cpu(pid) for pid in pids}
     time.sleep(0.3)
     return max(pids, key=lambda pid: cpu(pid) - first[pid])
+
+
+def test_a_simulation_past_the_wall_time_cap_is_stopped_and_says_why(tmp_path):
+    srv = Server(tmp_path, "--max-sim-s", "1")
+    try:
+        sim_id = srv.client.post("/simulations", json={
+            "scenario_id": "thesis_laps", "laps": 20, "duration": 600}).json()["id"]
+        deadline = time.monotonic() + 20
+        while (sim := srv.client.get(f"/simulations/{sim_id}").json())["status"] in (
+                "queued", "running"):
+            assert time.monotonic() < deadline, sim
+            time.sleep(0.2)
+        assert sim["status"] == "failed" and "--max-sim-s" in sim["error"], sim
+        flags = tmp_path / "stop"
+        while any(flags.iterdir()):  # cleared once the worker's run has returned
+            assert time.monotonic() < deadline + 30, "the worker was not stopped"
+            time.sleep(0.2)
+        busy = srv.workers_cpu_s()
+        time.sleep(0.5)
+        assert srv.workers_cpu_s() - busy < 0.05, "the worker still simulates"
+    finally:
+        srv.stop()

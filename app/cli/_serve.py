@@ -95,6 +95,8 @@ def serve(
         help="Where the SQLite database lives [default: the user data directory].")] = None,
     max_upload_mb: Annotated[float, typer.Option(min=0.001, help="Upload limit (MB).")] = 5.0,
     max_plan_s: Annotated[float, typer.Option(min=0.001, help="Longest plan (s).")] = 30.0,
+    max_sim_s: Annotated[float, typer.Option(
+        min=0.001, help="Longest simulation, in wall time (s).")] = 300.0,
     token: Annotated[str | None, typer.Option(
         envvar="TRACKSTAR_TOKEN", show_default=False,
         help="Require 'Authorization: Bearer TOKEN' on /api/ and a sign-in at "
@@ -131,7 +133,8 @@ def serve(
             raise InputError("the studio and the API need different ports")
         data = data_dir or Path(platformdirs.user_data_dir("trackstar"))
         settings = ServerSettings(data_dir=data, max_upload_mb=max_upload_mb,
-                                  max_plan_s=max_plan_s, ui_port=ui.getsockname()[1],
+                                  max_plan_s=max_plan_s, max_sim_s=max_sim_s,
+                                  ui_port=ui.getsockname()[1],
                                   access=access)
         if not _is_loopback(host) and access.token is None:
             print(f"warning: listening on {host} without --token: whoever reaches it may use "

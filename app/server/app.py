@@ -38,6 +38,7 @@ class ServerSettings:
     data_dir: Path
     max_upload_mb: float = 5.0
     max_plan_s: float = 30.0
+    max_sim_s: float = 300.0  # wall time of one simulation on the server
     ui_port: int | None = None
     workers: int | None = None  # default: one per CPU available to the process
     access: Access = field(default_factory=Access)  # who may call (app.access)
@@ -122,7 +123,7 @@ def create_app(settings: ServerSettings) -> FastAPI:
     @asynccontextmanager
     async def lifespan(app: FastAPI):
         store = Store(settings.data_dir / DATABASE)
-        planning = Planning(store, settings.max_plan_s, settings.workers)
+        planning = Planning(store, settings.max_plan_s, settings.workers, settings.max_sim_s)
         app.state.store, app.state.planning = store, planning
         routes_studies.resume_unfinished(store, planning)
         try:

@@ -6,6 +6,10 @@ the pool at most one run per worker at a time, so a single POST /plan waits for 
 for a whole batch. At shutdown the workers are terminated (a plan may have up to --max-plan-s
 left) and unfinished jobs are marked failed, so a restart shows what was interrupted.
 
+Cancelling the task that awaits a call (a client gone, DELETE of its job, a simulation past
+the server's wall-time cap) asks the worker running it to stop, through the call's `StopFlag`:
+the worker is free again within a batch of planning or a quarter second of simulating.
+
 A worker that dies (killed, out of memory, a crash in compiled code) breaks the whole pool and
 every call in flight on it. The pool is replaced and each of those calls runs once more, alone
 in a process of its own: the calls that were only in the way succeed, and the one that kills
@@ -17,14 +21,16 @@ from __future__ import annotations
 import asyncio
 import functools
 import logging
+import shutil
+import uuid
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 from app.planning import TrackSource, check_scenario, run_plan
-from app.pool import first_line, machine_workers, start_pool, stop_pool
+from app.pool import StopFlag, first_line, machine_workers, start_pool, stop_pool
 from app.server.store import Store
-from app.simulation import SimOptions, read_progress, request_stop, run_simulation, stop_path
+from app.simulation import SimOptions, read_progress, run_simulation
 from app.study.report import write_report
 from app.study.results import Results
 from app.study.runner import execute
@@ -57,26 +63,34 @@ def _brief(arg) -> str:
 class Planning:
     """The worker pool plus the asyncio tasks that run batch jobs on it."""
 
-    def __init__(self, store: Store, max_plan_s: float, workers: int | None = None) -> None:
+    def __init__(self, store: Store, max_plan_s: float, workers: int | None = None,
+                 max_sim_s: float = 300.0) -> None:
         self.store = store
         self.max_plan_s = max_plan_s
+        self.max_sim_s = max_sim_s  # wall time a simulation may keep a worker busy
         self.workers = workers or machine_workers()
         self.pool = self._start_pool()
         self._jobs: dict[str, asyncio.Task] = {}  # batch jobs and simulations
         self.sim_dir = store.path.parent / "simulations"  # per-run log CSV and progress files
         self.sim_dir.mkdir(exist_ok=True)
         self.studies_dir = store.path.parent / "studies"  # one results directory per study
+        self.stop_dir = store.path.parent / "stop"  # the StopFlags of calls asked to stop
+        shutil.rmtree(self.stop_dir, ignore_errors=True)  # left by a server that was killed
+        self.stop_dir.mkdir()
         store.fail_unfinished(CRASHED)
 
     def _start_pool(self) -> ProcessPoolExecutor:
         return start_pool(self.workers)
 
+    def _flag(self) -> StopFlag:
+        return StopFlag(self.stop_dir / uuid.uuid4().hex)
+
     async def _call(self, fn, *args, **kwargs):
-        loop = asyncio.get_running_loop()
+        """``fn(*args, **kwargs)`` in a worker; a ``stop`` keyword is the call's StopFlag."""
         call = functools.partial(fn, *args, **kwargs)
         pool = self.pool
         try:
-            return await loop.run_in_executor(pool, call)
+            return await _submit(pool, call)
         except BrokenProcessPool:  # a worker died with this call in flight: replace the pool
             if self.pool is pool:
                 self.pool = self._start_pool()
@@ -89,7 +103,7 @@ class Planning:
         call that crashes workers, and nothing else goes down with it."""
         quarantine = start_pool(1)
         try:
-            return await asyncio.get_running_loop().run_in_executor(quarantine, call)
+            return await _submit(quarantine, call)
         except BrokenProcessPool:
             log.error("a planning worker died twice running %s(%s)", call.func.__name__,
                       ", ".join(_brief(a) for a in call.args))
@@ -106,7 +120,7 @@ class Planning:
     async def plan(self, scenario: Scenario, options: PlanOptions,
                    track: TrackSource | None) -> PlanReport:
         return await self._call(run_plan, scenario, options, max_time=self.max_plan_s,
-                                track=track)
+                                track=track, stop=self._flag())
 
     def start_job(self, runs: list[tuple[Scenario, PlanOptions, TrackSource | None]]) -> str:
         """Store a job and run it in the background; returns its id."""
@@ -154,25 +168,30 @@ class Planning:
         return read_progress(self._progress(sim_id))
 
     def cancel_simulation(self, sim_id: str) -> None:
-        """Mark it cancelled and ask its worker to stop (the worker is freed, not killed)."""
+        """Mark it cancelled and stop its worker's run (the worker is freed, not killed)."""
         self.store.set_simulation(sim_id, "cancelled")
-        if sim_id in self._jobs:
-            request_stop(self._progress(sim_id))
+        task = self._jobs.get(sim_id)
+        if task is not None:
+            task.cancel()
 
     async def _simulate(self, sim_id: str, scenario: Scenario, options: SimOptions,
                         track) -> None:
         progress = self._progress(sim_id)
         try:
             self.store.set_simulation(sim_id, "running")
-            summary = await self._call(run_simulation, scenario, options, track,
-                                       self.sim_log(sim_id), progress)
+            summary = await asyncio.wait_for(
+                self._call(run_simulation, scenario, options, track, self.sim_log(sim_id),
+                           progress, stop=self._flag()), self.max_sim_s)
+        except TimeoutError:
+            self.store.set_simulation(sim_id, "failed", error=(
+                f"stopped after {self.max_sim_s:g} s of wall time, this server's limit for a "
+                f"simulation (--max-sim-s): simulate fewer seconds or at lower rates"))
         except Exception as exc:  # noqa: BLE001  (any failure is the run's result, not a hang)
             self.store.set_simulation(sim_id, "failed", error=first_line(exc))
         else:
             self.store.set_simulation(sim_id, "done", summary=summary)
         finally:
             progress.unlink(missing_ok=True)
-            stop_path(progress).unlink(missing_ok=True)
             self._jobs.pop(sim_id, None)
 
     # -- studies: the runs of app.study, each stored in the study's own results directory
@@ -193,7 +212,7 @@ class Planning:
             async with free:
                 try:
                     outcome, curve = await self._call(execute, study.scenarios[run.scenario],
-                                                      run, self.max_plan_s)
+                                                      run, self.max_plan_s, stop=self._flag())
                 except WorkerCrashed as exc:  # stored like any failed run; the others go on
                     outcome, curve = {"error": first_line(exc)}, []
             results.add(run, outcome, curve)
@@ -234,3 +253,17 @@ class Planning:
             task.cancel()
         await asyncio.gather(*self._jobs.values(), return_exceptions=True)
         await asyncio.to_thread(stop_pool, self.pool)
+
+
+async def _submit(pool: ProcessPoolExecutor, call: functools.partial):
+    """``call`` on ``pool``. Cancelled while the call runs, it sets the call's ``stop`` flag
+    (if it has one), which is cleared once the call has returned."""
+    future = pool.submit(call)
+    try:
+        return await asyncio.wrap_future(future)
+    except asyncio.CancelledError:
+        stop = call.keywords.get("stop")
+        if stop is not None and not future.done():
+            stop.set()
+            future.add_done_callback(lambda _: stop.clear())
+        raise

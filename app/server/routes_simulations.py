@@ -48,7 +48,7 @@ def get_simulation(request: Request, sim_id: str) -> dict:
 
 
 @router.delete("/simulations/{sim_id}", response_model=SimulationStatus)
-def cancel_simulation(request: Request, sim_id: str) -> dict:
+async def cancel_simulation(request: Request, sim_id: str) -> dict:
     """Stop a queued or running simulation within about a second (status `cancelled`, no
     log); a finished one is unchanged."""
     _simulation(request, sim_id)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -38,24 +39,26 @@ class Summary:
     report: str
 
 
-def execute(scenario: planner.Scenario, run: Run | SimRun,
-            max_time: float | None = None) -> tuple[dict, list]:
+def execute(scenario: planner.Scenario, run: Run | SimRun, max_time: float | None = None,
+            stop: Callable[[], bool] | None = None) -> tuple[dict, list]:
     """One run, in a worker: its outcome row and (planning runs) its cost curve (iteration,
     t_s, cost) — the numbers `trackstar plan --json` (`simulate --json`) prints for the same
-    options. ``max_time`` caps a plan's time (a server's --max-plan-s)."""
+    options. ``max_time`` caps a plan's time (a server's --max-plan-s); ``stop()`` ends our
+    planners' runs early (a cancelled study)."""
     started = time.perf_counter()
     try:
         outcome, curve = (_simulate(scenario, run) if isinstance(run, SimRun) else
-                          _plan(scenario, run, max_time))
+                          _plan(scenario, run, max_time, stop))
     except Exception as exc:  # noqa: BLE001  (stored with the run; the study goes on)
         outcome, curve = {"error": first_line(exc)}, []
     return outcome | {"wall_s": time.perf_counter() - started}, curve
 
 
-def _plan(scenario: planner.Scenario, run: Run, max_time: float | None) -> tuple[dict, list]:
+def _plan(scenario: planner.Scenario, run: Run, max_time: float | None,
+          stop: Callable[[], bool] | None) -> tuple[dict, list]:
     if run.planner in OMPL_PLANNERS:
         return _plan_ompl(scenario, run, max_time)
-    report = run_plan(scenario, run.options(), max_time=max_time)
+    report = run_plan(scenario, run.options(), max_time=max_time, stop=stop)
     rate = report.iterations / report.planning_time_s if report.planning_time_s > 0 else None
     outcome = {
         "solved": int(report.solved), "cost": report.cost,
