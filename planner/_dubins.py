@@ -10,7 +10,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from planner._jit import njit
 
 _TWO_PI = 2.0 * math.pi
 # Word table: the steering of the three segments of each word (+1 left, 0 straight, -1 right).

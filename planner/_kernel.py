@@ -23,9 +23,9 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
 from planner._dubins import turning_centres
+from planner._jit import njit
 from planner._paths import path_end, truncate, wrap_angle
 from planner._rng import uniform
 from planner._steer import (

@@ -17,7 +17,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from planner._jit import njit
 
 MAX_SEGMENTS = 5
 LEFT, STRAIGHT, RIGHT, TURN = 1, 0, -1, 2

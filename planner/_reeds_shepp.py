@@ -33,7 +33,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from planner._jit import njit
 
 PI = math.pi
 TWO_PI = 2.0 * math.pi

@@ -11,9 +11,9 @@ replanning. Nodes behind the car (other branches) are not kept.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from planner import _kernel as K
+from planner._jit import njit
 from planner._paths import TURN
 from planner._world import World, motion_free
 

@@ -8,7 +8,8 @@ planner's own array makes "same seed, same tree" hold regardless of what else ru
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, uint64
+
+from planner._jit import njit, uint64
 
 _MASK = (1 << 64) - 1
 

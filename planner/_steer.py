@@ -8,8 +8,6 @@ circles, which the tree keeps per node) and nobody computes it twice.
 
 from __future__ import annotations
 
-from numba import njit
-
 from planner._dubins import (
     dubins_length_cs,
     dubins_lower_bound,
@@ -17,6 +15,7 @@ from planner._dubins import (
     dubins_word_bound,
     turning_centres,
 )
+from planner._jit import njit
 from planner._paths import wrap_angle
 from planner._reeds_shepp import reeds_shepp_length, reeds_shepp_lower_bound, reeds_shepp_path
 from planner._straight import straight_heading, straight_length, straight_path

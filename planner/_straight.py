@@ -11,8 +11,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
+from planner._jit import njit
 from planner._paths import STRAIGHT, TURN, wrap_angle
 
 

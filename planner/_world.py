@@ -19,8 +19,8 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
+from planner._jit import njit
 from planner._paths import TURN, advance
 
 CONTACT = 1e-4

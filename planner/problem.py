@@ -12,8 +12,8 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from numba import float64, typeof
 
+from planner._jit import float64, typeof
 from planner._world import RADIUS, World, build_world, pose_clearance
 from planner.scenario import Box, Circle, Scenario, ScenarioError
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import sys
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -174,9 +175,24 @@ def collect_elements(root: ET.Element) -> list[_Element]:
     return walker.found
 
 
+def _path_parser():
+    """svgpathtools' path parser, imported without SciPy: svgpathtools imports scipy.integrate
+    (0.7 s, most of a track's first load) for arc lengths by quadrature, which it skips
+    without SciPy and which we do not use (tracks/_arclength.py measures our segments)."""
+    if "svgpathtools" not in sys.modules and "scipy.integrate" not in sys.modules:
+        sys.modules["scipy.integrate"] = None  # importing it raises ImportError now
+        try:
+            import svgpathtools  # noqa: F401
+        finally:
+            del sys.modules["scipy.integrate"]
+    from svgpathtools import Arc, Line, parse_path
+
+    return Arc, Line, parse_path
+
+
 def _segments(elem: _Element) -> list[list[Segment]]:
     """The element's subpaths in its local user units (split where the pen jumps)."""
-    from svgpathtools import Arc, Line, parse_path
+    Arc, Line, parse_path = _path_parser()
 
     try:
         parsed = parse_path(elem.path_data)
