@@ -116,6 +116,24 @@ def build_world(bounds, radius, circles, polygons, motions, rings=(), centreline
     return world
 
 
+def inflated(world: World, margin: float) -> World:
+    """The same world for a footprint ``margin`` larger: every clearance drops by exactly
+    ``margin``.
+
+    Every check measures point clearances (the distance grid ``sdf`` holds them too) from each
+    footprint disc's centre and subtracts that disc's radius, so growing every disc's radius —
+    the one disc of a disc car, each covering disc of a rectangle — is the whole change;
+    ``geo[RADIUS]``, the smallest disc's radius that sampling reads, grows with them.
+    """
+    if margin == 0.0:
+        return world
+    geo = world.geo.copy()
+    geo[RADIUS] += margin
+    discs = world.discs.copy()
+    discs[:, 1] += margin
+    return world._replace(geo=geo, discs=discs)
+
+
 @njit(cache=True)
 def offset(w: World, m: int, t: float):
     """Translation (dx, dy) of motion ``m`` at time t (FORMAT.md v1.1 semantics)."""

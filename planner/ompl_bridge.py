@@ -71,7 +71,7 @@ def setup_from_problem(problem) -> OmplSetup:
 
     return OmplSetup(problem.bounds, problem.start, problem.goal, problem.goal_position_tol,
                      problem.goal_heading_tol, problem.rho,
-                     lambda x, y, theta: clearance(x, y, theta) > 0.0, clearance)
+                     lambda x, y, theta: clearance(x, y, theta) > problem.margin, clearance)
 
 
 def _wrap(angle: float) -> float:

@@ -14,7 +14,7 @@ from functools import cached_property
 import numpy as np
 
 from planner._jit import float64, typeof
-from planner._world import RADIUS, World, build_world, pose_clearance
+from planner._world import RADIUS, World, build_world, inflated, pose_clearance
 from planner.scenario import Box, Circle, Scenario, ScenarioError
 
 __all__ = ["Problem", "compile_problem", "follow_waypoints", "resolve_track"]
@@ -33,6 +33,7 @@ class Problem:
     rho: float
     speed: float
     timed: bool
+    margin: float = 0.0  # the vehicle's safety margin: planned paths keep it (`plan_world`)
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
@@ -43,8 +44,13 @@ class Problem:
         """Area (m²) where the footprint's smallest disc fits among the static obstacles, from
         the clearance grid: the measure of the free space that RRT*'s radius depends on."""
         xmin, ymin, xmax, ymax = self.bounds
-        fits = np.mean(self.world.sdf > self.world.geo[RADIUS])
+        fits = np.mean(self.world.sdf > self.world.geo[RADIUS] + self.margin)
         return float(fits) * (xmax - xmin) * (ymax - ymin)
+
+    @cached_property
+    def plan_world(self) -> World:
+        """The world as planners check it: the footprint grown by the safety margin."""
+        return inflated(self.world, self.margin)
 
     def clearance(self, x: float, y: float, t: float = 0.0, theta: float = 0.0) -> float:
         """Signed clearance of the car's footprint at pose (x, y, theta) at time t (NaN: static
@@ -137,13 +143,15 @@ def compile_problem(scenario: Scenario, load_track=None) -> Problem:
         scenario=scenario, world=world, start=tuple(scenario.start), goal=tuple(scenario.goal),
         goal_position_tol=tol.position, goal_heading_tol=math.radians(tol.heading_deg),
         rho=scenario.vehicle.turning_radius, speed=scenario.vehicle.speed,
-        timed=scenario.has_motion)
+        timed=scenario.has_motion, margin=scenario.vehicle.safety_margin)
+    margin = problem.margin
+    kept = f" with the safety margin of {margin:g} m" if margin > 0 else ""
     start_clearance = problem.clearance(*problem.start[:2], 0.0, problem.start[2])
-    if start_clearance <= 0.0:
+    if start_clearance <= margin:
         raise ScenarioError(f"start {list(problem.start)} is in collision or outside the region "
-                            f"at t = 0 (clearance {start_clearance:.3f} m)")
+                            f"at t = 0{kept} (clearance {start_clearance:.3f} m)")
     goal_clearance = problem.clearance(*problem.goal[:2], math.nan, problem.goal[2])
-    if goal_clearance <= 0.0:
-        raise ScenarioError(f"goal {list(problem.goal)} is in collision or outside the region "
-                            f"(clearance {goal_clearance:.3f} m)")
+    if goal_clearance <= margin:
+        raise ScenarioError(f"goal {list(problem.goal)} is in collision or outside the region"
+                            f"{kept} (clearance {goal_clearance:.3f} m)")
     return problem

@@ -175,7 +175,7 @@ class Planner:
         target = done_before + iterations
         t0 = time.perf_counter()
         while self.iterations < target and not self.finished:
-            if not K.iterate(self._tree, self.problem.world, self._P,
+            if not K.iterate(self._tree, self.problem.plan_world, self._P,
                              target - self.iterations, events):
                 self._tree = K.grown(self._tree, 2 * self._tree.pose.shape[0])
         took = time.perf_counter() - t0
@@ -291,7 +291,8 @@ class Planner:
             raise ValueError("adopt() needs a planner that holds only its root")
         if self._tree.pose.shape[0] < old.nodes + 1:
             self._tree = K.grown(self._tree, 2 * (old.nodes + 1))
-        copied = reroot(old._tree, self._tree, self.problem.world, self._P, anchor, skip, bound)
+        copied = reroot(old._tree, self._tree, self.problem.plan_world, self._P, anchor, skip,
+                        bound)
         K._update_best(self._tree)
         return int(copied)
 

@@ -125,6 +125,9 @@ class Vehicle(StrictModel):
     max_speed: Speed | None = None
     max_accel: Annotated[float, Field(gt=0, le=MAX_ACCEL_M_S2)] = 1.0
     max_steer_rate_deg_s: Annotated[float, Field(gt=0, le=MAX_STEER_RATE_DEG_S)] = 180.0
+    safety_margin: Annotated[float, Field(ge=0, le=MAX_SIZE_M, allow_inf_nan=False)] = Field(
+        0.0, description="Distance (m) that planned paths keep from every obstacle and "
+                         "boundary, beyond the footprint.")
 
     @model_validator(mode="after")
     def _consistent(self) -> Vehicle:

@@ -171,3 +171,10 @@ def test_straight_steering_refuses_a_rectangular_footprint(tmp_path):
     out = run("plan", str(path), "--steering", "straight", "--json")
     assert out.returncode == 2 and out.stdout == ""
     assert "vehicle.radius" in out.stderr and len(out.stderr.strip().splitlines()) == 1
+
+
+def test_a_safety_margin_that_leaves_no_room_is_one_line_naming_it():
+    out = subprocess.run(["trackstar", "plan", "hallway", "--safety-margin", "9"],
+                         capture_output=True, text=True)
+    assert out.returncode == 2 and out.stderr.count("\n") == 1
+    assert "start [1.2, 1.3, 0.0]" in out.stderr and "safety margin of 9 m" in out.stderr

@@ -220,3 +220,17 @@ def test_the_se2_metric_picks_the_se2_nearest_and_still_plans_exact_paths():
     assert result.solved and first_collision(scenario_dict("slalom"), result.path[:, :3]) is None
     assert arc_mismatch(result.path[:, :3]) < 1e-6
     assert result.cost != plan("slalom", iterations=4000).cost  # another tree
+
+
+def test_a_safety_margin_is_kept_from_every_obstacle_and_wall():
+    """vehicle.safety_margin grows the checked footprint: the path of a disc car keeps it, as
+    an independent check with the disc grown by the margin confirms."""
+    scn = scenario_dict("hallway")
+    scn["vehicle"] = {**scn.get("vehicle", {}), "safety_margin": 0.1}
+    result = planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=4000)
+    assert result.solved and result.min_clearance_m >= 0.1
+    grown = {**scn, "vehicle": {**scn["vehicle"], "radius": scn["vehicle"]["radius"] + 0.1}}
+    assert first_collision(grown, result.path[:, :3]) is None
+    scn["vehicle"]["safety_margin"] = 5.0
+    with pytest.raises(planner.ScenarioError, match="with the safety margin of 5 m"):
+        planner.compile_problem(planner.parse_scenario(scn))

@@ -31,6 +31,10 @@ def plan(
         "--raceline", help="Also write the best path in the TUM raceline layout (speed within "
                            "the vehicle's max speed, 4 m/s² lateral, 2 m/s² longitudinal).",
     )] = None,
+    safety_margin: Annotated[float | None, typer.Option(
+        "--safety-margin", show_default=False,
+        help="Distance (m) the path keeps from every obstacle and boundary [default: the "
+             "scenario's vehicle.safety_margin, else 0].")] = None,
 ) -> None:
     """Plan a path for the car from start to goal with RRT or RRT*."""
     import planner as core
@@ -39,6 +43,9 @@ def plan(
 
     with user_errors():
         scenario_model = core.load_scenario(scenario)
+        if safety_margin is not None:
+            scenario_model = core.parse_scenario(scenario_model.model_dump(mode="json") | {
+                "vehicle": scenario_model.vehicle.model_dump() | {"safety_margin": safety_margin}})
         warm_kernels()
         report = run_plan(scenario_model, options)
         if raceline is not None and report.solved:

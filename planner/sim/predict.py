@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from planner._world import RADIUS, VMAX_OBS, WAYPOINTS, World
+from planner._world import VMAX_OBS, WAYPOINTS, World
 from planner.sim.sensing import Sensing
 
-__all__ = ["HORIZON_S", "inflated", "predicted_world"]
+__all__ = ["HORIZON_S", "predicted_world"]
 
 HORIZON_S = 1.0e4  # the predicted straight line is long enough for any run
 
@@ -34,21 +34,3 @@ def predicted_world(base: World, sensing: Sensing, t0: float) -> World:
     return base._replace(geo=geo, m_kind=np.full(n, WAYPOINTS, np.int64),
                          m_vel=np.zeros((n, 2)), m_wp_start=np.arange(0, 2 * n + 1, 2),
                          m_wp=wp)
-
-
-def inflated(world: World, margin: float) -> World:
-    """The same world for a footprint ``margin`` larger: every clearance drops by exactly
-    ``margin``.
-
-    Every check measures point clearances (the distance grid ``sdf`` holds them too) from each
-    footprint disc's centre and subtracts that disc's radius, so growing every disc's radius —
-    the one disc of a disc car, each covering disc of a rectangle — is the whole change;
-    ``geo[RADIUS]``, the smallest disc's radius that sampling reads, grows with them.
-    """
-    if margin == 0.0:
-        return world
-    geo = world.geo.copy()
-    geo[RADIUS] += margin
-    discs = world.discs.copy()
-    discs[:, 1] += margin
-    return world._replace(geo=geo, discs=discs)

@@ -18,12 +18,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from planner._paths import pose_at
-from planner._world import clearance, path_clearances
+from planner._world import clearance, inflated, path_clearances
 from planner.options import PlanOptions
 from planner.problem import Problem
 from planner.rrt import Planner
 from planner.sim.control import Reference
-from planner.sim.predict import inflated, predicted_world
+from planner.sim.predict import predicted_world
 from planner.sim.sensing import Sensing
 
 __all__ = ["Cycle", "Replanner", "warm_up"]
