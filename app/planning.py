@@ -8,11 +8,15 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from pydantic import BaseModel
 
 from planner.options import PlanOptions
 from planner.report import PlanReport
+
+if TYPE_CHECKING:
+    from planner.rrt import Planner
 
 __all__ = ["TrackSource", "check_scenario", "run_plan", "track_loader"]
 
@@ -55,15 +59,17 @@ def check_scenario(scenario, track: TrackSource | None = None) -> None:
 
 
 def run_plan(scenario, options: PlanOptions, *, max_time: float | None = None,
-             track: TrackSource | None = None,
-             stop: Callable[[], bool] | None = None) -> PlanReport:
+             track: TrackSource | None = None, stop: Callable[[], bool] | None = None,
+             observe: Callable[[Planner], None] | None = None, chunks: int = 1) -> PlanReport:
     """Plan a scenario (a `planner.Scenario` or its JSON object) and report the result.
 
     The time budget covers compiling the scenario too, so a run ends within it (plus at most
     one planner iteration); ``stop()`` ends planning early, e.g. when the client has gone.
-    Raises `planner.ScenarioError` (a ValueError) for scenarios that cannot be planned, or
-    whose compiling alone takes the whole time budget, and ValueError for bad options, each
-    with a message that names the problem.
+    ``observe(planner)`` sees the run after each of ``chunks`` equal parts of the budget (an
+    animation's frames); the tree is the same as in one part. Raises `planner.ScenarioError`
+    (a ValueError) for scenarios that cannot be planned, or whose compiling alone takes the
+    whole time budget, and ValueError for bad options, each with a message that names the
+    problem.
     """
     import planner as core
     from planner.report import plan_report
@@ -78,6 +84,15 @@ def run_plan(scenario, options: PlanOptions, *, max_time: float | None = None,
                 f"compiling the scenario took {compiling:.2f} s, the whole time budget of "
                 f"{budget_time:g} s: give more time")
         planning_time -= compiling
-    result = core.Planner(problem, options).solve(planning_time, options.iterations, stop)
+    planner = core.Planner(problem, options)
+    for k in range(chunks):
+        part = None if planning_time is None else planning_time / chunks
+        iterations = (None if options.iterations is None else
+                      options.iterations * (k + 1) // chunks - options.iterations * k // chunks)
+        if iterations != 0:
+            planner.advance(part, iterations, stop)
+        if observe is not None:
+            observe(planner)
+    result = planner.result()
     return plan_report(result, problem.scenario.name,
                        {"time": budget_time, "iterations": options.iterations})

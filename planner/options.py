@@ -12,7 +12,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from planner.scenario import ScenarioError, Speed
+from planner.scenario import Margin, ScenarioError, Speed
 from planner.steering import STEERINGS, SteeringName
 
 __all__ = ["METRICS", "PLANNERS", "PlanOptions", "PositiveFinite", "Seed"]
@@ -65,6 +65,9 @@ class PlanOptions(BaseModel):
         None, description="Informed sampling after the first solution [default: on for RRT*].")
     speed: Speed | None = Field(
         None, description="Planning speed v [m/s] [default: the scenario's vehicle.speed].")
+    safety_margin: Margin | None = Field(
+        None, description="Distance [m] the path keeps from every obstacle and boundary "
+                          "[default: the scenario's vehicle.safety_margin].")
 
     @property
     def dimensions(self) -> int:
@@ -108,5 +111,6 @@ class PlanOptions(BaseModel):
             gamma = 2.4 * (2.0 * (1.0 + 1.0 / d) * measure / unit_ball) ** (1.0 / d)
         informed = self.informed if self.informed is not None else self.planner == "rrtstar"
         speed = self.speed if self.speed is not None else problem.speed
+        margin = self.safety_margin if self.safety_margin is not None else problem.margin
         return self.model_copy(update={"eps": eps, "gamma": gamma, "informed": informed,
-                                       "speed": speed})
+                                       "speed": speed, "safety_margin": margin})

@@ -14,10 +14,10 @@ from functools import cached_property
 import numpy as np
 
 from planner._jit import float64, typeof
-from planner._world import RADIUS, World, build_world, inflated, pose_clearance
+from planner._world import RADIUS, World, build_world, pose_clearance
 from planner.scenario import Box, Circle, Scenario, ScenarioError
 
-__all__ = ["Problem", "compile_problem", "follow_waypoints", "resolve_track"]
+__all__ = ["Problem", "check_room", "compile_problem", "follow_waypoints", "resolve_track"]
 
 
 @dataclass(frozen=True)
@@ -33,7 +33,7 @@ class Problem:
     rho: float
     speed: float
     timed: bool
-    margin: float = 0.0  # the vehicle's safety margin: planned paths keep it (`plan_world`)
+    margin: float = 0.0  # the vehicle's safety margin: planned paths keep it
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
@@ -46,11 +46,6 @@ class Problem:
         xmin, ymin, xmax, ymax = self.bounds
         fits = np.mean(self.world.sdf > self.world.geo[RADIUS] + self.margin)
         return float(fits) * (xmax - xmin) * (ymax - ymin)
-
-    @cached_property
-    def plan_world(self) -> World:
-        """The world as planners check it: the footprint grown by the safety margin."""
-        return inflated(self.world, self.margin)
 
     def clearance(self, x: float, y: float, t: float = 0.0, theta: float = 0.0) -> float:
         """Signed clearance of the car's footprint at pose (x, y, theta) at time t (NaN: static
@@ -144,7 +139,12 @@ def compile_problem(scenario: Scenario, load_track=None) -> Problem:
         goal_position_tol=tol.position, goal_heading_tol=math.radians(tol.heading_deg),
         rho=scenario.vehicle.turning_radius, speed=scenario.vehicle.speed,
         timed=scenario.has_motion, margin=scenario.vehicle.safety_margin)
-    margin = problem.margin
+    check_room(problem, problem.margin)
+    return problem
+
+
+def check_room(problem: Problem, margin: float) -> None:
+    """Raise ScenarioError unless start and goal keep ``margin`` from everything."""
     kept = f" with the safety margin of {margin:g} m" if margin > 0 else ""
     start_clearance = problem.clearance(*problem.start[:2], 0.0, problem.start[2])
     if start_clearance <= margin:
@@ -154,4 +154,3 @@ def compile_problem(scenario: Scenario, load_track=None) -> Problem:
     if goal_clearance <= margin:
         raise ScenarioError(f"goal {list(problem.goal)} is in collision or outside the region"
                             f"{kept} (clearance {goal_clearance:.3f} m)")
-    return problem

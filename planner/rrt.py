@@ -18,9 +18,9 @@ from planner import _kernel as K
 from planner._paths import pose_at, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
-from planner._world import path_clearances
+from planner._world import inflated, path_clearances
 from planner.options import METRICS, PLANNERS, PlanOptions
-from planner.problem import Problem
+from planner.problem import Problem, check_room
 from planner.steering import STEERINGS
 from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points
 
@@ -76,6 +76,10 @@ class Planner:
         self.problem = problem
         self.options = (options or PlanOptions()).resolved(problem)
         s = self.options
+        if s.safety_margin > problem.margin:
+            check_room(problem, s.safety_margin)
+        # The world as this planner checks it: the footprint grown by the safety margin.
+        self._world = inflated(problem.world, s.safety_margin)
         xmin, ymin, xmax, ymax = problem.bounds
         diag = math.hypot(xmax - xmin, ymax - ymin)
         cell = min(max(s.eps / 10.0, diag / 400.0), diag / 8.0)
@@ -175,7 +179,7 @@ class Planner:
         target = done_before + iterations
         t0 = time.perf_counter()
         while self.iterations < target and not self.finished:
-            if not K.iterate(self._tree, self.problem.plan_world, self._P,
+            if not K.iterate(self._tree, self._world, self._P,
                              target - self.iterations, events):
                 self._tree = K.grown(self._tree, 2 * self._tree.pose.shape[0])
         took = time.perf_counter() - t0
@@ -207,7 +211,13 @@ class Planner:
     def solve(self, time_limit: float | None = 1.0, iterations: int | None = None,
               stop: Callable[[], bool] | None = None) -> Result:
         """Run until the time or iteration budget is spent (RRT: until the first solution) or
-        ``stop()`` is true (asked between batches of about 2 ms)."""
+        ``stop()`` is true (asked between batches of about 2 ms); the result."""
+        self.advance(time_limit, iterations, stop)
+        return self.result()
+
+    def advance(self, time_limit: float | None = 1.0, iterations: int | None = None,
+                stop: Callable[[], bool] | None = None) -> None:
+        """`solve` without building the result (which measures the best path's clearance)."""
         if time_limit is None and iterations is None:
             raise ValueError("give a time limit, an iteration budget, or both")
         warm_up()
@@ -226,7 +236,6 @@ class Planner:
                 break
             # Aim at ~2 ms batches: fine-grained budgets and cost-over-time samples.
             batch = max(1, min(4096, int(batch * (0.002 / took if took > 0 else 2.0))))
-        return self.result()
 
     # -- results -----------------------------------------------------------------------------
     def best_path_nodes(self) -> list[int]:
@@ -291,8 +300,7 @@ class Planner:
             raise ValueError("adopt() needs a planner that holds only its root")
         if self._tree.pose.shape[0] < old.nodes + 1:
             self._tree = K.grown(self._tree, 2 * (old.nodes + 1))
-        copied = reroot(old._tree, self._tree, self.problem.plan_world, self._P, anchor, skip,
-                        bound)
+        copied = reroot(old._tree, self._tree, self._world, self._P, anchor, skip, bound)
         K._update_best(self._tree)
         return int(copied)
 

@@ -69,6 +69,7 @@ Speed = Annotated[float, Field(ge=MIN_SPEED_M_S, le=MAX_SPEED_M_S, allow_inf_nan
 SignedSpeed = Annotated[float, Field(ge=-MAX_SPEED_M_S, le=MAX_SPEED_M_S)]  # an obstacle's
 Time = Annotated[float, Field(ge=-MAX_HORIZON_S, le=MAX_HORIZON_S)]
 Name = Annotated[Text, Field(max_length=MAX_NAME_CHARS)]
+Margin = Annotated[float, Field(ge=0, le=MAX_SIZE_M, allow_inf_nan=False)]
 Embedded = Annotated[Text, Field(max_length=MAX_EMBEDDED_CHARS)]
 
 
@@ -125,7 +126,7 @@ class Vehicle(StrictModel):
     max_speed: Speed | None = None
     max_accel: Annotated[float, Field(gt=0, le=MAX_ACCEL_M_S2)] = 1.0
     max_steer_rate_deg_s: Annotated[float, Field(gt=0, le=MAX_STEER_RATE_DEG_S)] = 180.0
-    safety_margin: Annotated[float, Field(ge=0, le=MAX_SIZE_M, allow_inf_nan=False)] = Field(
+    safety_margin: Margin = Field(
         0.0, description="Distance (m) that planned paths keep from every obstacle and "
                          "boundary, beyond the footprint.")
 

@@ -178,3 +178,20 @@ def test_a_safety_margin_that_leaves_no_room_is_one_line_naming_it():
                          capture_output=True, text=True)
     assert out.returncode == 2 and out.stderr.count("\n") == 1
     assert "start [1.2, 1.3, 0.0]" in out.stderr and "safety margin of 9 m" in out.stderr
+
+
+def test_animate_writes_a_gif_of_the_tree_growing(tmp_path):
+    from PIL import Image, ImageChops
+
+    gif = tmp_path / "run.gif"
+    out = subprocess.run(["trackstar", "plan", "slalom", "--iterations", "400", "--animate",
+                          str(gif)], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    with Image.open(gif) as im:
+        assert im.n_frames >= 20 and im.size[0] >= 640 and im.size[1] >= 480
+        first = im.convert("RGB")
+        im.seek(im.n_frames - 1)
+        assert ImageChops.difference(first, im.convert("RGB")).getbbox() is not None
+    bad = subprocess.run(["trackstar", "plan", "slalom", "--animate", str(tmp_path / "a.avi")],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "written as a .gif" in bad.stderr

@@ -31,23 +31,30 @@ def plan(
         "--raceline", help="Also write the best path in the TUM raceline layout (speed within "
                            "the vehicle's max speed, 4 m/s² lateral, 2 m/s² longitudinal).",
     )] = None,
-    safety_margin: Annotated[float | None, typer.Option(
-        "--safety-margin", show_default=False,
-        help="Distance (m) the path keeps from every obstacle and boundary [default: the "
-             "scenario's vehicle.safety_margin, else 0].")] = None,
+    animate: Annotated[Path | None, typer.Option(
+        "--animate", show_default=False,
+        help="Also write an animation of the run, for slides: the tree growing, its rewires "
+             "and the best path, 40 frames at 800x600 (.gif).")] = None,
 ) -> None:
     """Plan a path for the car from start to goal with RRT or RRT*."""
     import planner as core
+    from app.animate import FRAMES, FrameRecorder, check_animation_path, write_animation
     from app.planning import run_plan
     from app.raceline import path_raceline, raceline_limits
 
     with user_errors():
+        if animate is not None:
+            check_animation_path(animate)
         scenario_model = core.load_scenario(scenario)
-        if safety_margin is not None:
-            scenario_model = core.parse_scenario(scenario_model.model_dump(mode="json") | {
-                "vehicle": scenario_model.vehicle.model_dump() | {"safety_margin": safety_margin}})
         warm_kernels()
-        report = run_plan(scenario_model, options)
+        recorder = FrameRecorder()
+        report = run_plan(scenario_model, options, observe=recorder if animate else None,
+                          chunks=FRAMES if animate else 1)
+        if animate is not None:
+            p = report.parameters
+            write_animation(recorder.frames, recorder.problem,
+                            f"{report.scenario}: {p['planner']}, {p['steering']}, seed "
+                            f"{p['seed']}", animate)
         if raceline is not None and report.solved:
             limits = raceline_limits(vehicle=scenario_model.vehicle)
             raceline.write_text(path_raceline(report.path, limits))
