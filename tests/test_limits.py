@@ -137,8 +137,8 @@ def test_a_crowded_scene_compiles_within_its_time_budget():
                "goal": [99.5, 99.5, 0], "obstacles": [
                    {"type": "circle", "center": [float(x), float(y)], "radius": 0.05}
                    for x, y in centres]}
-    with pytest.raises(planner.ScenarioError, match="compiling the scenario took .* budget"):
-        run_plan(crowded, PlanOptions(time=0.001))
     started = time.perf_counter()
     report = run_plan(crowded, PlanOptions(time=1.0))
     assert time.perf_counter() - started < 1.5 and report.iterations > 0
+    compiling = 1.0 - report.planning_time_s  # what compiling took of the budget
+    assert 0.0 < compiling < 0.9
