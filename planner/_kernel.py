@@ -27,6 +27,7 @@ import numpy as np
 from planner._dubins import turning_centres
 from planner._jit import njit
 from planner._paths import path_end, truncate, wrap_angle
+from planner._polish import polish_path
 from planner._rng import uniform
 from planner._steer import (
     arrival_heading,
@@ -44,8 +45,8 @@ from planner._world import World, motion_free, static_clearance_estimate
 STEERING_METRIC, SE2_METRIC = range(2)  # planner.options.METRICS
 LANE_SHARE, LANE_SIGMA = 0.9, 0.25  # track scenarios: headings sampled along the lane
 NEAREST_BUCKETS = 256  # nearest's queue: half-cell buckets, the last one takes the rest
-# Counter indices.
-N, NGOAL, ITER, CHECKS, BEST, REWIRES, EVALS, IMPROVED, REFUSED = range(9)
+# Counter indices; POLISH_AT: the iteration at which the best path is next polished.
+N, NGOAL, ITER, CHECKS, BEST, REWIRES, EVALS, IMPROVED, REFUSED, POLISH_AT, NCOUNTERS = range(11)
 # Event row columns (only written when the event buffers are non-empty).
 EV_ITER, EV_XR, EV_YR, EV_THR, EV_NEAREST, EV_NEW, EV_PARENT, EV_NEAR_START, EV_NEAR_END, \
     EV_RADIUS, EV_BEST, EV_COLS = range(12)
@@ -80,7 +81,8 @@ class Events(NamedTuple):
     rows: np.ndarray  # (cap, EV_COLS)
     near: np.ndarray  # (cap,) int64, slices given by EV_NEAR_START:EV_NEAR_END
     rewires: np.ndarray  # (cap, 4) int64: iteration, node, old parent, new parent
-    cnt: np.ndarray  # int64[3]: rows, near entries, rewires used
+    polished: np.ndarray  # (cap,) int64: nodes added by polishing the best path
+    cnt: np.ndarray  # int64[4]: rows, near entries, rewires, polished nodes used
 
 
 def new_tree(capacity: int, grid: np.ndarray, rng: np.ndarray) -> Tree:
@@ -92,7 +94,7 @@ def new_tree(capacity: int, grid: np.ndarray, rng: np.ndarray) -> Tree:
         next_sibling=np.full(capacity, -1, np.int64), cell_head=np.full(nx * ny, -1, np.int64),
         cell_next=np.full(capacity, -1, np.int64), grid=grid,
         goal_nodes=np.zeros(capacity, np.int64), improved=np.zeros((capacity, 2)),
-        cnt=np.zeros(9, np.int64), rng=rng,
+        cnt=np.zeros(NCOUNTERS, np.int64), rng=rng,
         near=np.zeros(capacity, np.int64), near_len=np.zeros(capacity),
         near_key=np.zeros(capacity), stack=np.zeros(capacity, np.int64))
 
@@ -473,6 +475,40 @@ def _subtree_free_at(tree: Tree, w: World, P: np.ndarray, n: int, delta: float,
 
 
 @njit(cache=True)
+def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, counter, ev) -> bool:
+    """Polish the best path (`planner._polish`) and, if that shortens it, add the polished
+    poses to the tree as a chain from the root: the tree stays exact and RRT* goes on from it.
+    Returns whether it added them."""
+    n = 0
+    node = tree.cnt[BEST]
+    while node >= 0:
+        n += 1
+        node = tree.parent[node]
+    if n < 3 or tree.cnt[N] + n - 1 > tree.pose.shape[0]:
+        return False
+    poses = np.empty((n, 3))
+    node = root = tree.cnt[BEST]
+    for i in range(n - 1, -1, -1):
+        poses[i, :] = tree.pose[node]
+        root = node
+        node = tree.parent[node]
+    code = int(P[STEERING])
+    length = polish_path(w, code, P[RHO], P[SPEED], poses, kinds, lens, counter)
+    if length >= tree.cost[tree.cnt[BEST]] - 1e-9:
+        return False
+    parent = root
+    for i in range(1, n):
+        a, b = poses[i - 1], poses[i]
+        edge = steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], P[RHO], kinds, lens)
+        parent = add_node(tree, P, b[0], b[1], b[2], tree.cost[parent] + edge, parent, kinds,
+                          lens)
+        if ev.rows.shape[0] > 0 and ev.cnt[3] < ev.polished.shape[0]:
+            ev.polished[ev.cnt[3]] = parent
+            ev.cnt[3] += 1
+    return True
+
+
+@njit(cache=True)
 def _update_best(tree: Tree) -> None:
     best = tree.cnt[BEST]
     for g in range(tree.cnt[NGOAL]):
@@ -667,6 +703,12 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
                 ev.cnt[2] += 1
         if changed:
             _update_best(tree)
+        if (P[STAR] > 0.0 and not timed and tree.cnt[BEST] >= 0
+                and tree.cnt[ITER] >= tree.cnt[POLISH_AT]):
+            # At the first solution, then at twice as many iterations each time.
+            tree.cnt[POLISH_AT] = 2 * tree.cnt[ITER]
+            if _polish_best(tree, w, P, kinds, lens, counter, ev):
+                _update_best(tree)
         if record:
             ev.rows[row, EV_BEST] = tree.cost[tree.cnt[BEST]] if tree.cnt[BEST] >= 0 else math.inf
     tree.cnt[EVALS] += counter[0]

@@ -27,6 +27,7 @@ from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points
 __all__ = ["Planner", "Result", "warm_up"]
 
 CLEARANCE_SPACING_M = 0.005  # as FORMAT.md re-checks returned paths
+POLISHED_PER_BATCH = 4096  # nodes a batch's events can name as added by polishing
 
 @dataclass
 class Result:
@@ -105,7 +106,8 @@ class Planner:
         zero = np.zeros(5)
         K.add_node(self._tree, P, *problem.start, 0.0, -1, zero.astype(np.int8), zero)
         self._no_events = K.Events(np.zeros((0, K.EV_COLS)), np.zeros(0, np.int64),
-                                   np.zeros((0, 4), np.int64), np.zeros(3, np.int64))
+                                   np.zeros((0, 4), np.int64), np.zeros(0, np.int64),
+                                   np.zeros(4, np.int64))
         self._listeners: list[Callable[[TreeEvents], None]] = []
         self._clock = _Clock()
         self._compute_time = 0.0
@@ -194,7 +196,7 @@ class Planner:
         near_cap = max(64, 64 * iterations)
         return K.Events(np.zeros((iterations, K.EV_COLS)), np.zeros(near_cap, np.int64),
                         np.zeros((max(64, 16 * iterations), 4), np.int64),
-                        np.zeros(3, np.int64))
+                        np.zeros(POLISHED_PER_BATCH, np.int64), np.zeros(4, np.int64))
 
     def _note_progress(self, iterations_before: int, batch_s: float) -> None:
         """Time-stamp the batch's improvements, which the kernel records by iteration: inside
@@ -331,7 +333,7 @@ class Planner:
 
 def _named(ev: K.Events) -> TreeEvents:
     """The kernel's event columns as `TreeEvents` fields."""
-    n_rows, n_near, n_rw = ev.cnt
+    n_rows, n_near, n_rw, n_polished = ev.cnt
     rows = ev.rows[:n_rows]
 
     def ints(col):
@@ -342,6 +344,7 @@ def _named(ev: K.Events) -> TreeEvents:
         nearest=ints(K.EV_NEAREST), new=ints(K.EV_NEW), parent=ints(K.EV_PARENT),
         radius=rows[:, K.EV_RADIUS].copy(), best_cost=rows[:, K.EV_BEST].copy(),
         rewires=[Rewire(*map(int, r)) for r in ev.rewires[:n_rw]],
+        polished=ev.polished[:n_polished].copy(),
         _near=ev.near[:n_near].copy(), _near_span=ints([K.EV_NEAR_START, K.EV_NEAR_END]))
 
 

@@ -75,6 +75,7 @@ class TreeEvents:
     radius: np.ndarray  # (n,): the near radius r(n) (0 for RRT, inf for k-nearest)
     best_cost: np.ndarray  # (n,): the best cost after the iteration (inf: none yet)
     rewires: list[Rewire]
+    polished: np.ndarray  # nodes added as the polished best path (`planner._polish`), in order
     _near: np.ndarray = field(repr=False)  # the near sets, concatenated
     _near_span: np.ndarray = field(repr=False)  # (n, 2): each iteration's slice of _near
 

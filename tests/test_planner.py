@@ -94,7 +94,9 @@ def test_events_report_every_iteration_and_cost_nothing_without_listener():
     rewires = [r for e in seen for r in e.rewires]
     snap = watched.snapshot()
     added = {int(e.new[0]): int(e.parent[0]) for e in seen if e.new[0] >= 0}
-    assert len(added) == snap.nodes - 1  # every node but the root, added once
+    polished = [int(n) for e in seen for n in e.polished]
+    assert len(added) + len(polished) == snap.nodes - 1  # every node but the root, added once
+    assert not set(added) & set(polished)
     for e in seen:
         if e.new[0] >= 0:  # x_new's parent is x_min, one of its near nodes or x_nearest
             assert e.parent[0] in set(e.near_of(0)) | {e.nearest[0]}

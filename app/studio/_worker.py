@@ -135,7 +135,7 @@ class PlannerWorker:
         if ev is None:
             live.chunks.set(0, run.edge_points(0, SEG))
             return
-        for node in ev.new[ev.new >= 0]:
+        for node in (*ev.new[ev.new >= 0], *ev.polished):
             live.chunks.set(int(node), run.edge_points(node, SEG))
         now = time.monotonic()
         rewired = []
