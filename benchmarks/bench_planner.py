@@ -2,6 +2,10 @@
 
     python benchmarks/bench_planner.py        # 5 static scenarios, budgets 0.1 s and 1 s, seeds 0-4
 
+"Best known" costs come from benchmarks/results/best_known.json; a scenario missing there is first
+run for --long-s seconds (default 20) with seeds 0-2 by ours and, with OMPL, by BIT*, and the
+lowest cost any of them reached is stored with how it was found.
+
 Each OMPL run is a fresh process (OMPL's seed is process-wide), one per budget. Ours runs in this
 process after one untimed warm-up solve per scenario (compilation is not what we measure), once per
 seed at the largest budget: its iterations do not depend on the budget, so its cost at a smaller
@@ -28,6 +32,8 @@ from tqdm import tqdm
 STATIC_SCENARIOS = ["open_field", "hallway", "slalom", "parking", "oval_track"]
 OMPL_PLANNERS = ["RRTstar", "InformedRRTstar", "BITstar"]
 OURS = "ours"
+BEST_KNOWN = Path(__file__).parent / "results" / "best_known.json"
+LONG_SEEDS = [0, 1, 2]
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -39,6 +45,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--budgets", nargs="+", type=float, default=[0.1, 1.0], metavar="SECONDS")
     parser.add_argument("--only", choices=[OURS, "ompl"], help="run only our planner or only OMPL")
     parser.add_argument("--json", type=Path, metavar="OUT", help="also write every run's record")
+    parser.add_argument("--long-s", type=float, default=20.0, metavar="SECONDS",
+                        help="budget of the long runs that find a missing best known cost")
     args = parser.parse_args(argv)
     args.budgets = sorted(args.budgets)
     return args
@@ -110,6 +118,49 @@ def _our_record(result, scenario: str, seed: int, budget: float, setup_s: float)
     }
 
 
+def best_known(trackstar, paths: dict[str, Path], scenarios: dict[str, dict], long_s: float,
+               with_ompl: bool) -> dict[str, dict]:
+    """{scenario: {"cost", "by"}}: stored ones, and long runs for the missing ones (stored)."""
+    known = json.loads(BEST_KNOWN.read_text()) if BEST_KNOWN.exists() else {}
+    missing = [name for name in paths if name not in known]
+    runs = len(missing) * len(LONG_SEEDS) * (2 if with_ompl else 1)
+    with tqdm(total=runs, unit="long run", disable=not runs) as bar:
+        for name in missing:
+            found = []
+            for seed in LONG_SEEDS:
+                bar.set_postfix_str(f"{name} ours seed {seed}")
+                result = trackstar.solve(trackstar.load_scenario(paths[name]), time_limit=long_s,
+                                         seed=seed)
+                found.append((result.cost, f"ours, {long_s:g} s, seed {seed}"))
+                bar.update()
+                if with_ompl:
+                    from ompl_baseline import run_ompl_isolated
+
+                    bar.set_postfix_str(f"{name} BIT* seed {seed}")
+                    r = run_ompl_isolated(scenarios[name], "BITstar", long_s, seed)
+                    found.append((r["cost"], f"OMPL BIT*, {long_s:g} s, seed {seed}"))
+                    bar.update()
+            cost, by = min((c, b) for c, b in found if c is not None)
+            known[name] = {"cost": cost, "by": by}
+            BEST_KNOWN.write_text(json.dumps(known, indent=1) + "\n")
+    return known
+
+
+def best_known_table(summary: dict, scenarios: list[str], budgets: list[float],
+                     known: dict[str, dict]) -> str:
+    """Markdown table of our median cost at each budget over the best known cost."""
+    cols = " | ".join(f"cost {b:g} s / best known" for b in budgets)
+    lines = [f"| scenario | best known (how) | {cols} |", "|---|---|" + "---:|" * len(budgets)]
+    for scenario in scenarios:
+        ours = summary.get((scenario, OURS))
+        if ours is None or scenario not in known:
+            continue
+        best = known[scenario]
+        ratios = " | ".join(_ratio(ours["budgets"][b][0], best["cost"], ".3f") for b in budgets)
+        lines.append(f"| {scenario} | {best['cost']:.3f} ({best['by']}) | {ratios} |")
+    return "\n".join(lines)
+
+
 def _median(values: list) -> float | None:
     values = [v for v in values if v is not None]
     return statistics.median(values) if values else None
@@ -145,8 +196,8 @@ def _fmt(value: float | None, spec: str) -> str:
     return "—" if value is None else format(value, spec)
 
 
-def _ratio(ours: float | None, theirs: float | None) -> str:
-    return "—" if ours is None or not theirs else f"{ours / theirs:.2f}"
+def _ratio(ours: float | None, theirs: float | None, spec: str = ".2f") -> str:
+    return "—" if ours is None or not theirs else format(ours / theirs, spec)
 
 
 def results_table(summary: dict, scenarios: list[str], budgets: list[float]) -> str:
@@ -208,7 +259,8 @@ def _revision() -> str:
     return done.stdout.strip() or "(not a git checkout)"
 
 
-def report(summary: dict, args: argparse.Namespace, command: str, seconds: float) -> str:
+def report(summary: dict, args: argparse.Namespace, command: str, seconds: float,
+           known: dict[str, dict]) -> str:
     """The whole Markdown report: how it was run, the table, the ratios when both sides ran."""
     parts = [
         "# Planner benchmark: Trackstar vs OMPL (Dubins)",
@@ -221,6 +273,10 @@ def report(summary: dict, args: argparse.Namespace, command: str, seconds: float
     ]
     if args.only is None:
         parts.append(ratios_table(summary, args.scenarios, args.budgets))
+    if known:
+        parts.append(f"Best known: the lowest cost in {BEST_KNOWN.name}, found by long runs "
+                     f"(--long-s, seeds {LONG_SEEDS}) of ours and of OMPL BIT*.")
+        parts.append(best_known_table(summary, args.scenarios, args.budgets, known))
     return "\n\n".join(parts) + "\n"
 
 
@@ -244,7 +300,10 @@ def main(argv: list[str] | None = None) -> None:
             records += ompl_runs(scenarios, args.seeds, args.budgets, bar)
     options = sys.argv[1:] if argv is None else argv
     command = " ".join(["python benchmarks/bench_planner.py", *options])
-    text = report(summarise(records, args.budgets), args, command, time.perf_counter() - start)
+    known = (best_known(ours, paths, scenarios, args.long_s, with_ompl=args.only is None)
+             if ours is not None else {})
+    text = report(summarise(records, args.budgets), args, command, time.perf_counter() - start,
+                  known)
 
     print(text)
     _harness.write_result("planner", text)
