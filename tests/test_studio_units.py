@@ -233,3 +233,70 @@ def test_the_raceline_download_is_the_best_path_within_the_scenario_vehicle():
     lines = run.raceline().splitlines()
     vx = [float(line.split(";")[5]) for line in lines[1:]]
     assert lines[0].startswith("# s_m; x_m") and max(vx) == pytest.approx(1.5) and vx[-1] == 0
+
+
+def test_the_vehicle_folder_reads_back_the_scenario_car_and_keeps_what_it_does_not_show():
+    from app.studio._vehicle import fields_of, vehicle_from_fields
+
+    base = {"wheelbase": 0.3, "max_steer_deg": 30.0, "speed": 1.5, "safety_margin": 0.02,
+            "max_accel": 2.0, "min_turning_radius": 0.6,
+            "footprint": {"type": "rectangle", "length": 0.5, "width": 0.25,
+                          "rear_overhang": 0.05}}
+    fields = fields_of(planner.scenario.Vehicle.model_validate(base))
+    assert vehicle_from_fields(base, fields) == base
+    disc = vehicle_from_fields(base, dict(fields, footprint="disc", radius=0.1, wheelbase=0.25))
+    assert disc["radius"] == 0.1 and "footprint" not in disc and disc["max_accel"] == 2.0
+    assert "min_turning_radius" not in disc  # it would overrule the new wheelbase
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    ({"wheelbase": -0.1}, "wheelbase: Input should be greater than 0"),
+    ({"radius": -0.05}, "radius: Input should be greater than or equal to 0"),
+    ({"footprint": "rectangle", "length": 5.0, "width": 0.01}, "needs 500 discs"),
+    ({"safety_margin": -1.0}, "safety_margin: Input should be greater than or equal to 0"),
+    ({"max_steer_deg": 90.0}, "max_steer_deg: Input should be less than 90"),
+])
+def test_the_vehicle_folder_refuses_what_the_scenario_model_refuses(change, message):
+    from app.studio._vehicle import fields_of, vehicle_from_fields
+
+    fields = dict(fields_of(planner.scenario.Vehicle()), length=0.4, width=0.2)
+    with pytest.raises(ValueError, match=message):
+        vehicle_from_fields({}, dict(fields, **change))
+
+
+class _Scene:
+    """Records what `draw_car` adds: node name → points."""
+
+    def __init__(self) -> None:
+        self.nodes = {}
+
+    def add_frame(self, name, **_):
+        return name
+
+    def add_mesh_simple(self, name, verts, *_, **__):
+        self.nodes[name] = verts
+
+    def add_line_segments(self, name, seg, *_, **__):
+        self.nodes[name] = seg
+
+
+def test_the_drawn_car_is_the_planned_one_its_discs_and_its_safety_margin():
+    from app.studio._scene import draw_car
+    from app.studio._vehicle import fields_of, vehicle_from_fields
+
+    fields = dict(fields_of(planner.scenario.Vehicle()), footprint="rectangle", length=0.4,
+                  width=0.2, safety_margin=0.02)
+    scenario = dict(default_scenario("thesis"), vehicle=vehicle_from_fields({}, fields))
+    problem = planner.compile_problem(planner.parse_scenario(scenario))
+    vehicle = problem.scenario.vehicle
+    (d0, r), (d1, _) = vehicle.discs()
+    assert np.allclose(problem.world.discs, vehicle.discs())  # what the planner checks
+    scene = _Scene()
+    draw_car(scene, "/car", vehicle, 0.01, (0.0, 0.0, 0.0))
+    body = scene.nodes["/car/body"][:, :2]
+    assert np.allclose(body.min(axis=0), [-0.0, -0.1]) and np.allclose(body.max(axis=0),
+                                                                        [0.4, 0.1])
+    for name, reach in (("/car/discs", r), ("/car/margin", r + 0.02)):
+        pts = scene.nodes[name][:, 0, :2]
+        gap = np.minimum(np.hypot(pts[:, 0] - d0, pts[:, 1]), np.hypot(pts[:, 0] - d1, pts[:, 1]))
+        assert np.allclose(gap, reach, atol=2e-3), name

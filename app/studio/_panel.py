@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import planner
 import tracks
 from app.studio._extend import FIRST_NOTE, render
+from app.studio._vehicle import APPLIED, FOOTPRINTS
 
 __all__ = ["MOTIONS", "PLANNERS", "SPEEDS", "STEERINGS", "Panel", "build_panel"]
 
@@ -48,6 +49,8 @@ class Panel:
     scenario_save: object
     scenario_load: object
     scenario_name: object
+    vehicle: dict  # field name → control (app/studio/_vehicle.py)
+    vehicle_note: object
     planner_name: object
     steering: object
     eps: object
@@ -56,7 +59,6 @@ class Panel:
     goal_bias: object
     budget: object
     seed: object
-    speed_v: object
     rate: object
     run: object
     pause: object
@@ -106,6 +108,22 @@ def build_panel(gui) -> Panel:
         scenario_upload = gui.add_upload_button("Upload scenario (JSON)", mime_type=".json")
         scenario_save = gui.add_button("Save to server")
         scenario_load = gui.add_button("Load from server")
+    with gui.add_folder("Vehicle", expand_by_default=False):
+        vehicle = {
+            "wheelbase": gui.add_number("Wheelbase (m)", 0.44, step=0.01),
+            "max_steer_deg": gui.add_number("Max steering angle (deg)", 26.0, step=1.0),
+            "footprint": gui.add_dropdown("Footprint", FOOTPRINTS, initial_value="disc"),
+            "radius": gui.add_number("Disc radius (m)", 0.0, step=0.01,
+                                     hint="0: the car is a point"),
+            "length": gui.add_number("Car length (m)", 0.4, step=0.01, visible=False),
+            "width": gui.add_number("Car width (m)", 0.2, step=0.01, visible=False),
+            "speed": gui.add_number("Speed (m/s)", 1.0, step=0.1,
+                                    hint="The speed the planner times its paths for"),
+            "safety_margin": gui.add_number(
+                "Safety margin (m)", 0.0, step=0.01,
+                hint="Distance planned paths keep from every obstacle and boundary"),
+        }
+        vehicle_note = gui.add_markdown(APPLIED)
     with gui.add_folder("Planner"):
         planner_name = gui.add_dropdown("Planner", tuple(PLANNERS), initial_value="RRT*")
         steering = gui.add_dropdown("Steering", tuple(STEERINGS))
@@ -115,8 +133,6 @@ def build_panel(gui) -> Panel:
         goal_bias = gui.add_slider("Goal bias", 0.0, 0.5, 0.01, 0.05)
         budget = gui.add_number("Budget (iterations)", 30000, min=1, step=1000)
         seed = gui.add_number("Seed", 0, min=0, step=1)
-        speed_v = gui.add_number("v (m/s, 0 = scenario's)", 0.0, min=0.0, step=0.1,
-                                 hint="Planning speed; 0 plans at the scenario's vehicle.speed")
         rate = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="max")
         run = gui.add_button("Run")
         pause = gui.add_button("Pause")

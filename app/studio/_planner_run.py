@@ -60,8 +60,7 @@ class PlannerRun:
         return planner.PlanOptions(
             planner=PLANNERS[u.planner_name.value], steering=STEERINGS[u.steering.value],
             eps=u.eps.value or None, gamma=u.gamma.value or None, k_rrt=u.k_rrt.value or None,
-            goal_bias=float(u.goal_bias.value), seed=int(u.seed.value),
-            speed=u.speed_v.value or None)
+            goal_bias=float(u.goal_bias.value), seed=int(u.seed.value))
 
     def reset(self) -> None:
         """A fresh run of the stage's problem with the current settings (the old worker is

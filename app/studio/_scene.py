@@ -23,6 +23,7 @@ __all__ = ["DRAFT_RGB", "Z", "add_grid", "car_outline", "curvature_colors", "dra
 Z = {"surface": -0.02, "centre": 0.002, "tree": 0.006, "flash": 0.008, "obstacle": 0.009,
      "path": 0.01, "step": 0.012, "pose": 0.014, "car": 0.016}
 CAR_RGB, CAR_LINE_RGB = (250, 250, 250), (20, 20, 20)
+DISCS_RGB, MARGIN_RGB = (120, 120, 120), (235, 235, 235)  # checked discs, margin's dashes
 DRAFT_RGB = (255, 120, 0)  # what is being clicked: polygon corners, a drawn track
 
 
@@ -181,13 +182,20 @@ def _car_ring(vehicle, marker: float) -> np.ndarray:
     return np.array([[back, -w], [back + fp.length, -w], [back + fp.length, w], [back, w]])
 
 
+def _discs_ring(vehicle, grow: float) -> np.ndarray:
+    """The outline of the discs the planner checks, each grown by ``grow`` (> 0 for a point)."""
+    discs = [shapely.Point(dx, 0.0).buffer(r + grow, quad_segs=16) for dx, r in vehicle.discs()]
+    return np.asarray(shapely.union_all(discs).exterior.coords)[:-1]
+
+
 def draw_car(scene, name: str, vehicle, marker: float, pose):
     """The car as the planner plans it, in a frame ``name`` at ``pose`` (x, y, heading) that
     the caller moves: its footprint rectangle (the rear axle ``rear_overhang`` in front of the
-    rear bumper), else the disc of ``vehicle.radius``. A point car (radius 0) gets a disc of two
-    ``marker`` (the start's and goal's size) only so that it stays visible. White with a dark
-    outline and a line from the rear axle to the front, so the heading shows on a disc too; the
-    Drive car and the simulated car are this one drawing."""
+    rear bumper) with the discs that cover it, which are what the planner checks, else the disc
+    of ``vehicle.radius``; the safety margin around them dashed. A point car (radius 0) gets a
+    disc of two ``marker`` (the start's and goal's size) only so that it stays visible. White
+    with a dark outline and a line from the rear axle to the front, so the heading shows on a
+    disc too; the Drive car and the simulated car are this one drawing."""
     ring = _car_ring(vehicle, marker)
     frame = scene.add_frame(name, show_axes=False, position=(*pose[:2], 0.0),
                             wxyz=yaw_wxyz(pose[2]))
@@ -197,6 +205,14 @@ def draw_car(scene, name: str, vehicle, marker: float, pose):
         f"{name}/outline", np.concatenate([polyline_segments(ring, Z["car"], True),
                                            polyline_segments(nose, Z["car"])]),
         CAR_LINE_RGB, thickness=2.5, thickness_units="screen")
+    if vehicle.footprint is not None:
+        scene.add_line_segments(f"{name}/discs",
+                                polyline_segments(_discs_ring(vehicle, 0.0), Z["car"], True),
+                                DISCS_RGB, thickness=1.5, thickness_units="screen")
+    if vehicle.safety_margin > 0:
+        dashes = polyline_segments(_discs_ring(vehicle, vehicle.safety_margin), Z["car"], True)
+        scene.add_line_segments(f"{name}/margin", dashes[::2], MARGIN_RGB, thickness=1.5,
+                                thickness_units="screen")
     return frame
 
 

@@ -34,6 +34,7 @@ from app.studio._sources import Sources
 from app.studio._stage import Stage
 from app.studio._studies import StudiesView
 from app.studio._track_drawing import TrackDrawing
+from app.studio._vehicle import VehicleForm
 
 __all__ = ["Session"]
 
@@ -57,6 +58,8 @@ class Session:
         self.editor = Editor(client.scene, u, self.stage, self.apply_scenario, self.drawing.add,
                              self.notify)
         self.sim = SimView(client.gui, client.scene, self.clock)
+        self.vehicle = VehicleForm(u.vehicle, u.vehicle_note,
+                                   lambda: self.stage.scenario.get("vehicle", {}), self.set_vehicle)
         self.studies = StudiesView(client.gui, client, api_url, self.notify)
         self._wire()
         self._unfitted_ticks = 10  # fit the view this many ticks after the browser's camera
@@ -90,7 +93,7 @@ class Session:
         u.scenario_save.on_click(lambda _: src.save_to_server())
         u.scenario_load.on_click(lambda _: src.load_from_server())
         for control in (u.planner_name, u.steering, u.eps, u.gamma, u.k_rrt, u.goal_bias,
-                        u.budget, u.seed, u.speed_v):
+                        u.budget, u.seed):
             control.on_update(lambda _: self._locked(run.reset))
         u.reset.on_click(lambda _: self._locked(run.reset))
         u.rate.on_update(lambda _: run.set_rate())
@@ -107,17 +110,31 @@ class Session:
             fn()
 
     # -- what spans parts ----------------------------------------------------------------------
-    def set_track(self, track: tracks.Track, scenario: dict) -> None:
+    def set_track(self, track: tracks.Track, scenario: dict, fit: bool = True) -> None:
         """Show a new track with its scenario: a fresh scene, so every part draws anew."""
         with self._lock:
             vehicle = planner.parse_scenario(scenario).vehicle
+            self.vehicle.show(vehicle)
             self.sim.clear()  # while its drawing is still in the scene
             self.stage.show_track(track, vehicle)
             self.editor.forget_gizmos()
             self.drawing.forget_gizmos()
             self.planning.new_track(track, vehicle)
             self.apply_scenario(scenario)
-            self.stage.fit()
+            if fit:
+                self.stage.fit()
+
+    def set_vehicle(self, vehicle: dict) -> str | None:
+        """The scenario with a new car, or why it cannot have it (the start or goal no longer
+        fits). The track's curvature colours and the profiles' limits are the car's: the track
+        is shown anew, in the same view."""
+        scenario = dict(self.stage.scenario, vehicle=vehicle)
+        try:
+            planner.compile_problem(planner.parse_scenario(scenario))
+        except (planner.ScenarioError, ValueError) as exc:
+            return str(exc)
+        self.set_track(self.stage.track, scenario, fit=False)
+        return None
 
     def apply_scenario(self, scenario: dict) -> bool:
         """Compile and show ``scenario`` (start, goal, obstacles); keeps the old one on error.
