@@ -204,7 +204,8 @@ def test_an_uploaded_csv_track_is_offered_shown_and_embedded_with_its_side_width
             for k in range(n)]
     ui = SimpleNamespace(svg_upload=SimpleNamespace(value=SimpleNamespace(
         name="ring.csv", content="\n".join(rows).encode())),
-        svg_path=SimpleNamespace(options=(), visible=False, value="—"))
+        svg_path=SimpleNamespace(options=(), visible=False, value="—"),
+        track=SimpleNamespace(options=("thesis",), value="thesis"))
     shown = []
     sources = Sources(None, ui, None, "", lambda track, scenario: shown.append((track, scenario)),
                       lambda *message: pytest.fail(str(message)))
@@ -213,6 +214,7 @@ def test_an_uploaded_csv_track_is_offered_shown_and_embedded_with_its_side_width
     ui.svg_path.value = "ring"  # what the dropdown's update fires
     sources.svg_path_chosen()
     track, scenario = shown[-1]
+    assert ui.track.value == "ring" and ui.track.options[-1] == "ring"  # named in the dropdown
     again = resolve_track(planner.parse_scenario(json.loads(json.dumps(scenario))))
     assert again.length_m == pytest.approx(track.length_m, rel=1e-6) and again.closed
     assert [w[0] for w in again.widths_at(np.array([1.0]))] == pytest.approx([0.5, 1.0])
@@ -300,3 +302,18 @@ def test_the_drawn_car_is_the_planned_one_its_discs_and_its_safety_margin():
         pts = scene.nodes[name][:, 0, :2]
         gap = np.minimum(np.hypot(pts[:, 0] - d0, pts[:, 1]), np.hypot(pts[:, 0] - d1, pts[:, 1]))
         assert np.allclose(gap, reach, atol=2e-3), name
+
+
+def test_an_svg_without_a_usable_path_says_why():
+    from types import SimpleNamespace
+
+    from app.studio._sources import Sources
+
+    svg = b'<svg xmlns="http://www.w3.org/2000/svg"><text>no track</text></svg>'
+    ui = SimpleNamespace(svg_upload=SimpleNamespace(value=SimpleNamespace(name="a.svg",
+                                                                          content=svg)))
+    said = []
+    Sources(None, ui, None, "", lambda *_: pytest.fail("shown"),
+            lambda *message: said.append(message)).svg_uploaded()
+    assert said == [("No track in a.svg", "the document has no path of positive length")]
+

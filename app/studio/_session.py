@@ -71,7 +71,7 @@ class Session:
         """Each control to the part that owns what it changes."""
         u, stage, run, sim = self.ui, self.stage, self.planning, self.sim
         src, edit, drawing = self.sources, self.editor, self.drawing
-        u.track.on_update(lambda _: src.show_library(u.track.value))
+        u.track.on_update(lambda _: src.track_chosen())
         u.svg_upload.on_upload(lambda _: src.svg_uploaded())
         u.svg_path.on_update(lambda _: src.svg_path_chosen())
         u.fit.on_click(lambda _: stage.fit())

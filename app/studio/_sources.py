@@ -28,24 +28,39 @@ class Sources:
         self.client, self.ui, self.stage, self.api_url = client, ui, stage, api_url
         self._set_track, self.notify = set_track, notify
         self._upload = None  # the uploaded file (viser's UploadedFile: name, content)
+        self._shown: str | None = None  # the shown track's name in the Track dropdown
 
     # -- tracks ---------------------------------------------------------------------------------
     def show_library(self, name: str) -> None:
         self._set_track(tracks.load_library_track(name), default_scenario(name))
+        self._name_track(name)
+
+    def track_chosen(self) -> None:
+        """The Track dropdown changed: a library track other than the one shown is loaded."""
+        if self._shown is not None and self.ui.track.value != self._shown:
+            self.show_library(self.ui.track.value)
+
+    def _name_track(self, name: str) -> None:
+        """The Track dropdown names the shown track; one not in the library (uploaded, drawn,
+        a scenario's) is offered next to the library's until another is shown."""
+        library = tuple(tracks.library_names())
+        self._shown = None  # changing the options resets the value: not a choice
+        self.ui.track.options = library if name in library else (*library, name)
+        self.ui.track.value = name
+        self._shown = name
 
     def svg_uploaded(self) -> None:
         """Offer the file's paths (an SVG's elements, a CSV's one centreline); the first one is
-        shown."""
+        shown. A file with none says why, as importing it does."""
         upload = self.ui.svg_upload.value
         try:
             report = tracks.inspect_track(upload.content, filename=upload.name)
+            if not report["paths"]:
+                tracks.load_track(upload.content, filename=upload.name)  # raises the reason
         except (tracks.TrackError, ValueError, KeyError) as exc:
-            self.notify("Track not loaded", str(exc))
+            self.notify(f"No track in {upload.name}", str(exc))
             return
         paths = [p["selector"] for p in report["paths"]]
-        if not paths:
-            self.notify("Track not loaded", "the file has no path")
-            return
         self._upload = upload
         self.ui.svg_path.options = tuple(paths)
         self.ui.svg_path.visible = len(paths) > 1
@@ -67,10 +82,13 @@ class Sources:
 
     def use_track(self, track: tracks.Track) -> None:
         """A track of no scenario (uploaded, drawn) with a start, a goal and no obstacles."""
+        name = track.name or "custom"
         try:
-            self._set_track(track, custom_scenario(track, track.name or "custom"))
+            self._set_track(track, custom_scenario(track, name))
         except (planner.ScenarioError, ValueError, tracks.TrackError) as exc:
             self.notify("Track not usable", str(exc))
+            return
+        self._name_track(name)
 
     # -- scenarios ------------------------------------------------------------------------------
     def load_scenario(self, data: dict) -> None:
@@ -79,12 +97,14 @@ class Sources:
         scenario = planner.parse_scenario(data)  # raises ScenarioError with a one-line message
         if scenario.track is not None:
             self._set_track(resolve_track(scenario), data)
+            self._name_track(scenario.track.name)
             return
         xmin, ymin, xmax, ymax = scenario.bounds
         box = [[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax], [xmin, ymin]]
         track = tracks.Track(name=scenario.name, closed=False, width_m=1e-3, segments=tuple(
             tracks.line(np.array(a), np.array(b)) for a, b in itertools.pairwise(box)))
         self._set_track(track, data)
+        self._name_track(f"{scenario.name} (bounds)")
 
     def scenario_uploaded(self) -> None:
         try:
