@@ -13,6 +13,7 @@ import planner
 from app.studio._custom import Draft, custom_scenario
 from app.studio._edit import moved_obstacle, parse_waypoints
 from app.studio._extend import LINES, StepInfo, explain, render
+from app.studio._panel import STEERINGS
 from app.studio._scenario import default_scenario
 from app.studio._tree import EdgeChunks
 from planner.problem import resolve_track
@@ -317,3 +318,47 @@ def test_an_svg_without_a_usable_path_says_why():
             lambda *message: said.append(message)).svg_uploaded()
     assert said == [("No track in a.svg", "the document has no path of positive length")]
 
+
+def test_iterations_per_second_is_the_rate_achieved_under_the_speed_throttle():
+    import time
+
+    from app.studio._worker import PlannerWorker
+
+    worker = PlannerWorker(_problem(), planner.PlanOptions(seed=0), budget=100, rate=200.0)
+    try:
+        worker.run()
+        deadline = time.monotonic() + 10
+        while worker.live.state != "done" and time.monotonic() < deadline:
+            time.sleep(0.02)
+        time.sleep(0.05)
+        assert worker.live.metrics["iterations_per_s"] == pytest.approx(200, rel=0.25)
+    finally:
+        worker.stop()
+
+
+def test_a_negative_budget_is_refused_with_the_models_message():
+    from types import SimpleNamespace
+
+    from app.studio._planner_run import PlannerRun
+
+    ui = SimpleNamespace(planner_name=SimpleNamespace(value="RRT*"),
+                         steering=SimpleNamespace(value=next(iter(STEERINGS))),
+                         eps=SimpleNamespace(value=0.0), gamma=SimpleNamespace(value=0.0),
+                         k_rrt=SimpleNamespace(value=0.0), goal_bias=SimpleNamespace(value=0.05),
+                         seed=SimpleNamespace(value=0), budget=SimpleNamespace(value=-5))
+    run = PlannerRun(None, None, ui, None, None, None)
+    with pytest.raises(ValueError, match="Budget: Input should be greater than or equal to 1"):
+        run.options()
+
+
+def test_step_labels_never_share_a_place():
+    from app.studio._live_view import step_labels
+
+    rand, nearest = np.array([1.0, 1.0, 0.0]), np.array([0.0, 0.0, 0.0])
+    reached = step_labels({"x_rand": rand, "nearest": nearest, "new": rand.copy()}, 0.1)
+    assert [text for _, text, _, _ in reached] == ["x_new = x_rand", "x_nearest"]
+    short = step_labels({"x_rand": rand, "nearest": nearest, "new": rand * 0.98}, 0.1)
+    assert {text: anchor for _, text, _, anchor in short} == {
+        "x_rand": "bottom-left", "x_nearest": "bottom-left", "x_new": "top-left"}
+    blocked = step_labels({"x_rand": nearest + 0.05, "nearest": nearest, "new": None}, 0.1)
+    assert [anchor for _, _, _, anchor in blocked] == ["top-left", "bottom-left"]

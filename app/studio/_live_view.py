@@ -14,7 +14,7 @@ import numpy as np
 from app.studio._scene import Z, polyline_segments
 from app.studio._worker import FLASH_S, Live
 
-__all__ = ["LiveView"]
+__all__ = ["LiveView", "step_labels"]
 
 TREE_RGB = (70, 150, 235)
 PATH_RGB = (255, 90, 200)
@@ -36,6 +36,27 @@ def _edges(pts_list: list[np.ndarray], z: float) -> np.ndarray:
     if not pts_list:
         return np.zeros((0, 2, 3), np.float32)
     return np.concatenate([polyline_segments(p, z) for p in pts_list])
+
+
+def step_labels(st: dict, marker: float) -> list[tuple[str, str, tuple[float, float], str]]:
+    """(node, text, position, anchor) of the step's labels, right of their points: x_nearest
+    above, x_new below, x_rand above when x_new is elsewhere (then it is ε from x_nearest) and
+    below when not, so that close points keep their labels apart. A Steer that reached the
+    sample puts x_new on x_rand: one label names both."""
+    def at(pose, above: bool) -> tuple[tuple[float, float], str]:
+        dy = marker if above else -marker
+        return (float(pose[0]) + marker, float(pose[1]) + dy), ("bottom-left" if above
+                                                               else "top-left")
+
+    rand, new = st["x_rand"], st["new"]
+    same = new is not None and math.dist(rand[:2], new[:2]) < 0.1 * marker
+    elsewhere = new is not None and not same
+    out = [("step_rand_l", "x_new = x_rand" if same else "x_rand", *at(rand, elsewhere))]
+    if st["nearest"] is not None:
+        out.append(("step_nearest_l", "x_nearest", *at(st["nearest"], True)))
+    if elsewhere:
+        out.append(("step_new_l", "x_new", *at(new, False)))
+    return out
 
 
 class LiveView:
@@ -105,14 +126,13 @@ class LiveView:
         m, z = self.marker, Z["step"]
         xr = st["x_rand"]
         self._put("step_rand", _circle(xr[0], xr[1], m, z, 12), (255, 255, 255), 3.0)
-        self._label("step_rand_l", "x_rand", xr)
         if st["nearest"] is not None:
             self._put("step_nearest", _circle(*st["nearest"][:2], m, z, 12), (90, 170, 255), 3.0)
-            self._label("step_nearest_l", "x_nearest", st["nearest"])
+        for label in step_labels(st, m):
+            self._label(*label)
         if st["new"] is not None:
             nx, ny = st["new"][:2]
             self._put("step_new", _circle(nx, ny, m, z, 12), NEW_RGB, 3.0)
-            self._label("step_new_l", "x_new", st["new"])
             if st["radius"] > 0 and math.isfinite(st["radius"]):
                 self._put("step_radius", _circle(nx, ny, st["radius"], z, 64), (250, 220, 90), 1.5)
             near = [_circle(x, y, 0.4 * m, z, 8) for x, y, _ in st["near"]]
@@ -120,13 +140,14 @@ class LiveView:
             self._put("step_parent", _edges([st["parent_edge"]], z), NEW_RGB, 5.0)
         self._put("step_rewired", _edges([n for _, n in st["rewired"]], z), (80, 255, 220), 4.0)
 
-    def _label(self, name: str, text: str, pose) -> None:
+    def _label(self, name: str, text: str, where, anchor: str) -> None:
         h = self._handles.get(name)
-        pos = (float(pose[0]) + self.marker, float(pose[1]) + self.marker, Z["step"])
+        pos = (*where, Z["step"])
         if h is None:
-            self._handles[name] = self.scene.add_label(f"/live/{name}", text, position=pos)
+            self._handles[name] = self.scene.add_label(f"/live/{name}", text, position=pos,
+                                                       anchor=anchor)
         else:
-            h.position, h.visible = pos, True
+            h.position, h.text, h.anchor, h.visible = pos, text, anchor, True
 
     def clear(self) -> None:
         for h in [*self._chunks.values(), *self._handles.values()]:

@@ -9,11 +9,12 @@ import tracks
 from app.studio._extend import FIRST_NOTE, render
 from app.studio._vehicle import APPLIED, FOOTPRINTS
 
-__all__ = ["MOTIONS", "PLANNERS", "SPEEDS", "STEERINGS", "Panel", "build_panel"]
+__all__ = ["DEFAULT_BUDGET", "MOTIONS", "PLANNERS", "SPEEDS", "STEERINGS", "Panel", "build_panel"]
 
 PLANNERS = {"RRT*": "rrtstar", "RRT": "rrt"}
 STEERINGS = {s.label: s.name for s in planner.STEERINGS.values()}
 MOTIONS = ("static", "velocity", "waypoints", "follow track")
+DEFAULT_BUDGET = 30000  # iterations
 SPEEDS = {"max": None, "2000 it/s": 2000.0, "200 it/s": 200.0, "20 it/s": 20.0}
 
 
@@ -131,7 +132,7 @@ def build_panel(gui) -> Panel:
         gamma = gui.add_number("γ (0 = auto)", 0.0, min=0.0, step=0.5)
         k_rrt = gui.add_number("k (0 = radius form)", 0.0, min=0.0, step=0.5)
         goal_bias = gui.add_slider("Goal bias", 0.0, 0.5, 0.01, 0.05)
-        budget = gui.add_number("Budget (iterations)", 30000, min=1, step=1000)
+        budget = gui.add_number("Budget (iterations)", DEFAULT_BUDGET, min=1, step=1000)
         seed = gui.add_number("Seed", 0, min=0, step=1)
         rate = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="max")
         run = gui.add_button("Run")

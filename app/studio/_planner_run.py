@@ -12,17 +12,19 @@ import math
 import time
 
 import numpy as np
+from pydantic import ValidationError
 
 import planner
 import tracks
 from app.raceline import path_raceline, raceline_limits
 from app.studio._extend import FIRST_NOTE, explain, render
 from app.studio._live_view import LiveView
-from app.studio._panel import PLANNERS, SPEEDS, STEERINGS
+from app.studio._panel import DEFAULT_BUDGET, PLANNERS, SPEEDS, STEERINGS
 from app.studio._plots import Profiles
 from app.studio._scenario import goal_fraction
 from app.studio._scene import draw_car, marker_size, yaw_wxyz
 from app.studio._worker import PlannerWorker
+from planner.validation import describe
 
 __all__ = ["PlannerRun"]
 
@@ -55,12 +57,18 @@ class PlannerRun:
                                       raceline_limits(vehicle=vehicle))
 
     def options(self) -> planner.PlanOptions:
-        """The planner panel as `PlanOptions`: 0 in a number field means "derived"."""
+        """The planner panel as `PlanOptions`: 0 in a number field means "derived". Raises
+        ValueError with the model's one-line message for a value it refuses (a typed Budget of
+        -5 gets past the field's minimum)."""
         u = self.ui
-        return planner.PlanOptions(
-            planner=PLANNERS[u.planner_name.value], steering=STEERINGS[u.steering.value],
-            eps=u.eps.value or None, gamma=u.gamma.value or None, k_rrt=u.k_rrt.value or None,
-            goal_bias=float(u.goal_bias.value), seed=int(u.seed.value))
+        try:
+            return planner.PlanOptions(
+                planner=PLANNERS[u.planner_name.value], steering=STEERINGS[u.steering.value],
+                eps=u.eps.value or None, gamma=u.gamma.value or None,
+                k_rrt=u.k_rrt.value or None, goal_bias=float(u.goal_bias.value),
+                seed=int(u.seed.value), iterations=int(u.budget.value))
+        except ValidationError as exc:
+            raise ValueError(describe(exc).replace("iterations:", "Budget:")) from None
 
     def reset(self) -> None:
         """A fresh run of the stage's problem with the current settings (the old worker is
@@ -74,8 +82,8 @@ class PlannerRun:
             options.resolved(problem)  # refuses a robot this steering cannot drive
         except ValueError as exc:
             self.notify("Planner options", str(exc))
-            options = planner.PlanOptions()
-        self.worker = PlannerWorker(problem, options, int(self.ui.budget.value),
+            options = planner.PlanOptions(iterations=DEFAULT_BUDGET)
+        self.worker = PlannerWorker(problem, options, options.iterations,
                                     SPEEDS[self.ui.rate.value])
         self._view = LiveView(self.scene, self.worker.live, marker_size(problem.bounds))
         self._shown = {"metrics": -1, "best": 0, "step": 0}
