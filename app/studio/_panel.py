@@ -128,13 +128,21 @@ def build_panel(gui) -> Panel:
     with gui.add_folder("Planner"):
         planner_name = gui.add_dropdown("Planner", tuple(PLANNERS), initial_value="RRT*")
         steering = gui.add_dropdown("Steering", tuple(STEERINGS))
-        eps = gui.add_number("ε (m, 0 = auto)", 0.0, min=0.0, step=0.05)
-        gamma = gui.add_number("γ (0 = auto)", 0.0, min=0.0, step=0.5)
-        k_rrt = gui.add_number("k (0 = radius form)", 0.0, min=0.0, step=0.5)
-        goal_bias = gui.add_slider("Goal bias", 0.0, 0.5, 0.01, 0.05)
+        eps = gui.add_number("ε (step length, m; 0 = auto)", 0.0, min=0.0, step=0.05,
+                             hint="The longest edge one iteration adds; auto: 15 % of the "
+                                  "track's size, at least two turning radii")
+        gamma = gui.add_number("γ (rewiring radius scale; 0 = auto)", 0.0, min=0.0, step=0.5,
+                               hint="RRT* rewires within r = γ (log n / n)^(1/d) of a new "
+                                    "node; auto: from the free area")
+        k_rrt = gui.add_number("k-nearest factor (0: use the radius)", 0.0, min=0.0, step=0.5,
+                               hint="RRT* rewires the k·log n nearest nodes instead of those "
+                                    "within the radius (OMPL: 5.5)")
+        goal_bias = gui.add_slider("Goal bias (probability)", 0.0, 0.5, 0.01, 0.05,
+                                   hint="How often the goal is sampled instead of a random pose")
         budget = gui.add_number("Budget (iterations)", DEFAULT_BUDGET, min=1, step=1000)
         seed = gui.add_number("Seed", 0, min=0, step=1)
-        rate = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="max")
+        rate = gui.add_dropdown("Pace (it/s)", tuple(SPEEDS), initial_value="max",
+                                hint="Slows the planner down to watch the tree grow")
         run = gui.add_button("Run")
         pause = gui.add_button("Pause")
         step = gui.add_button("Step")

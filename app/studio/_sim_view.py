@@ -83,13 +83,13 @@ def build_controls(gui) -> SimControls:
         common = {"aspect": 2.0, "legend": {"show": True}, "scales": {"x": {"time": False}}}
         steering = gui.add_uplot(
             (t, nan, nan), ({"label": "t (s)"},
-                            {"label": "δ Soll (deg)", "stroke": "#e8542f", "width": 1.5},
-                            {"label": "δ Ist (deg)", "stroke": "#4a90e2", "width": 2.0}),
-            title="Steering: setpoint (Soll) vs actual (Ist)", **common)
+                            {"label": "δ commanded (deg)", "stroke": "#e8542f", "width": 1.5},
+                            {"label": "δ actual (deg)", "stroke": "#4a90e2", "width": 2.0}),
+            title="Steering: commanded (Soll) vs actual (Ist)", **common)
         lateral = gui.add_uplot(
             (t, nan), ({"label": "t (s)"},
                        {"label": "lateral error (cm)", "stroke": "#8e44ad", "width": 1.5}),
-            title="Lateral error to the committed path", **common)
+            title="Lateral error to the path being followed", **common)
     return SimControls(rate, controller, noise, seed, simulate_, stop, status, metrics,
                        steering, lateral)
 
