@@ -355,7 +355,13 @@ def car_pixels(img: np.ndarray) -> np.ndarray:
 
 
 def test_drive_car_moves_the_footprint_along_the_best_path(browser, ui_url):
+    """The car of the Vehicle folder (a 0.4 × 0.2 m rectangle, not the point the scenario
+    plans by default) is planned, driven and carried by the downloaded scenario."""
     page = open_tab(browser, ui_url)
+    page.get_by_text("Vehicle", exact=True).click()
+    page.get_by_label("Footprint", exact=True).click()
+    page.get_by_role("option", name="rectangle").click()
+    page.get_by_text("Car length (m)").wait_for()
     click(page, "Run")
     wait_until(page, lambda img: (np.abs(img - [255, 90, 200]).sum(axis=2) < 60).sum() > 200,
                timeout=30)
@@ -368,6 +374,10 @@ def test_drive_car_moves_the_footprint_along_the_best_path(browser, ui_url):
     assert car_pixels(first).sum() > 30 and car_pixels(later).sum() > 30, "no car drawn"
     moved = np.linalg.norm(centroid(car_pixels(later)) - centroid(car_pixels(first)))
     assert moved > 40, f"the car moved {moved:.0f} px in 1.5 s"
+    size = np.ptp(np.argwhere(car_pixels(later)), axis=0).max()
+    assert size > 40, f"the car is {size} px long: not the 0.4 m rectangle"  # a point: ~10 px
+    assert download_scenario(page)["vehicle"]["footprint"] == {
+        "type": "rectangle", "length": 0.4, "width": 0.2}
     page.close()
 
 
