@@ -430,7 +430,7 @@ def test_a_scenario_saved_to_the_server_loads_back_with_its_track(browser, urls,
 def test_straight_line_steering_draws_the_classic_rrt_picture(browser, ui_url):
     """The registry's third steering, chosen from the dropdown: straight edges, a path."""
     page = open_tab(browser, ui_url)
-    page.get_by_label("Steering").click(force=True)
+    page.get_by_label("Steering", exact=True).click(force=True)
     page.get_by_role("option", name="Straight line").click(force=True)
     blue = tree_pixels(canvas_pixels(page))
     click(page, "Run")
