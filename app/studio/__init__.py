@@ -47,9 +47,16 @@ def launch(host: str, port: int, api_url: str, access: Access | None = None) -> 
     lock = threading.Lock()
 
     def _open(client: viser.ClientHandle) -> None:
+        """Build the tab's session and keep it until `_disconnect`; if the tab closed while it
+        was built, `_disconnect` found nothing to close, so the session closes itself here
+        (else its threads would run, and hold it, forever). viser drops a client from
+        `get_clients` before it calls `_disconnect`, so exactly one of the two closes it."""
         session = Session(client, api_url)
         with lock:
-            handle.sessions[client.client_id] = session
+            if client.client_id in server.get_clients():
+                handle.sessions[client.client_id] = session
+                return
+        session.close()
 
     @server.on_client_connect
     def _connect(client: viser.ClientHandle) -> None:
