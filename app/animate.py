@@ -15,7 +15,8 @@ import numpy as np
 
 from planner.tree import TreeSnapshot
 
-__all__ = ["FRAMES", "Frame", "FrameRecorder", "check_animation_path", "write_animation"]
+__all__ = ["FRAMES", "Frame", "FrameRecorder", "animation_gif", "check_animation_path", "title",
+           "write_animation"]
 
 FRAMES = 40
 SIZE_IN, DPI = (8.0, 6.0), 100  # 800 × 600 pixels
@@ -40,6 +41,27 @@ class FrameRecorder:
     def __call__(self, planner) -> None:
         self.problem = planner.problem
         self.frames.append(Frame(planner.snapshot(), planner.iterations, planner.best_cost))
+
+
+def title(scenario: str, options) -> str:
+    return f"{scenario}: {options.planner}, {options.steering}, seed {options.seed}"
+
+
+def animation_gif(problem, options) -> bytes:
+    """The run of ``options`` (an iteration budget) on ``problem`` as a GIF: the tree the
+    studio's Run grows with the same settings, for its download."""
+    import tempfile
+
+    from app.planning import advance_in_parts
+    from planner.rrt import Planner
+
+    recorder = FrameRecorder()
+    advance_in_parts(Planner(problem, options), None, options.iterations, FRAMES, recorder)
+    name = problem.scenario.name if problem.scenario is not None else "scenario"
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "run.gif"
+        write_animation(recorder.frames, problem, title(name, options), path)
+        return path.read_bytes()
 
 
 def check_animation_path(path: Path) -> None:

@@ -18,7 +18,7 @@ from planner.report import PlanReport
 if TYPE_CHECKING:
     from planner.rrt import Planner
 
-__all__ = ["TrackSource", "check_scenario", "run_plan", "track_loader"]
+__all__ = ["TrackSource", "advance_in_parts", "check_scenario", "run_plan", "track_loader"]
 
 MIN_PLANNING_SHARE = 0.1  # of the time budget, however long compiling took
 
@@ -55,6 +55,21 @@ def _compile(scenario, track: TrackSource | None):
     return core.compile_problem(scenario, load_track=track_loader(track))
 
 
+def advance_in_parts(planner: Planner, time_s: float | None, iterations: int | None,
+                     parts: int, observe: Callable[[Planner], None] | None = None,
+                     stop: Callable[[], bool] | None = None) -> None:
+    """Spend the budget in ``parts`` equal parts, ``observe(planner)`` after each (an
+    animation's frames): the iterations add up exactly, so the tree is that of one part."""
+    for k in range(parts):
+        part = None if time_s is None else time_s / parts
+        share = None if iterations is None else (iterations * (k + 1) // parts
+                                                 - iterations * k // parts)
+        if share != 0:
+            planner.advance(part, share, stop)
+        if observe is not None:
+            observe(planner)
+
+
 def check_scenario(scenario, track: TrackSource | None = None) -> None:
     """Raise `planner.ScenarioError` unless the scenario can be planned (start and goal free)."""
     _compile(scenario, track)
@@ -84,14 +99,7 @@ def run_plan(scenario, options: PlanOptions, *, max_time: float | None = None,
         planning_time = max(budget_time - (time.perf_counter() - started),
                             MIN_PLANNING_SHARE * budget_time)
     planner = core.Planner(problem, options)
-    for k in range(chunks):
-        part = None if planning_time is None else planning_time / chunks
-        iterations = (None if options.iterations is None else
-                      options.iterations * (k + 1) // chunks - options.iterations * k // chunks)
-        if iterations != 0:
-            planner.advance(part, iterations, stop)
-        if observe is not None:
-            observe(planner)
+    advance_in_parts(planner, planning_time, options.iterations, chunks, observe, stop)
     result = planner.result()
     return plan_report(result, problem.scenario.name,
                        {"time": budget_time, "iterations": options.iterations})

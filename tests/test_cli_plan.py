@@ -7,6 +7,9 @@ import time
 import pytest
 from conftest import scenario_dict
 
+import planner
+from app.animate import check_animation_path
+
 
 def run(*args, timeout=120):
     return subprocess.run(["trackstar", *args], capture_output=True, text=True, timeout=timeout)
@@ -192,6 +195,27 @@ def test_animate_writes_a_gif_of_the_tree_growing(tmp_path):
         first = im.convert("RGB")
         im.seek(im.n_frames - 1)
         assert ImageChops.difference(first, im.convert("RGB")).getbbox() is not None
-    bad = subprocess.run(["trackstar", "plan", "slalom", "--animate", str(tmp_path / "a.avi")],
-                         capture_output=True, text=True)
-    assert bad.returncode == 2 and "written as a .gif" in bad.stderr
+    with pytest.raises(ValueError, match="written as a .gif"):
+        check_animation_path(tmp_path / "a.avi")
+
+
+def test_an_animated_run_is_the_run_and_the_studio_gets_it_as_a_gif():
+    """Planning in 40 parts (the frames) grows the same tree as in one; the studio's download
+    draws the run of its settings."""
+    import io
+
+    from PIL import Image
+
+    from app.animate import FRAMES, FrameRecorder, animation_gif
+    from app.planning import run_plan
+
+    options = planner.PlanOptions(iterations=300, seed=2)
+    slalom = planner.load_scenario("slalom")
+    whole = run_plan(slalom, options)
+    recorder = FrameRecorder()
+    parts = run_plan(slalom, options, observe=recorder, chunks=FRAMES)
+    assert (parts.cost, parts.nodes, parts.path) == (whole.cost, whole.nodes, whole.path)
+    assert [f.iterations for f in recorder.frames][-1] == 300 and len(recorder.frames) == FRAMES
+    gif = animation_gif(planner.compile_problem(slalom), options)
+    with Image.open(io.BytesIO(gif)) as im:
+        assert im.format == "GIF" and im.n_frames == FRAMES

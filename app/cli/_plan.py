@@ -38,7 +38,7 @@ def plan(
 ) -> None:
     """Plan a path for the car from start to goal with RRT or RRT*."""
     import planner as core
-    from app.animate import FRAMES, FrameRecorder, check_animation_path, write_animation
+    from app.animate import FRAMES, FrameRecorder, check_animation_path, title, write_animation
     from app.planning import run_plan
     from app.raceline import path_raceline, raceline_limits
 
@@ -51,10 +51,8 @@ def plan(
         report = run_plan(scenario_model, options, observe=recorder if animate else None,
                           chunks=FRAMES if animate else 1)
         if animate is not None:
-            p = report.parameters
             write_animation(recorder.frames, recorder.problem,
-                            f"{report.scenario}: {p['planner']}, {p['steering']}, seed "
-                            f"{p['seed']}", animate)
+                            title(report.scenario, options), animate)
         if raceline is not None and report.solved:
             limits = raceline_limits(vehicle=scenario_model.vehicle)
             raceline.write_text(path_raceline(report.path, limits))

@@ -150,6 +150,10 @@ def build_panel(gui) -> Panel:
         drive = gui.add_button("Drive car")
         raceline_download = gui.add_button("Download raceline (CSV)",
                                             hint="The best path in the TUM raceline layout")
+        animation_download = gui.add_button(
+            "Download animation (GIF)",
+            hint="This run, seed and budget as 40 frames: the tree growing, its rewires and "
+                 "the best path, for slides")
         status = gui.add_markdown("Status: ready")
     with gui.add_folder("Metrics"):
         metrics = gui.add_markdown("—")

@@ -102,6 +102,7 @@ class Session:
         u.step.on_click(lambda _: run.worker.step())
         u.drive.on_click(lambda _: self._locked(run.drive))
         u.raceline_download.on_click(lambda _: self._download_raceline())
+        u.animation_download.on_click(lambda _: self._download_animation())
         sim.ui.simulate.on_click(lambda _: self._simulate())
         sim.ui.stop.on_click(lambda _: sim.stop())
 
@@ -180,6 +181,30 @@ class Session:
             self.notify("No path yet", "press Run until a path to the goal is found")
             return
         self.client.send_file_download("raceline.csv", text.encode(), save_immediately=True)
+
+    def _download_animation(self) -> None:
+        """The current settings' run drawn as a GIF, rendered on a thread of its own (a few
+        seconds) while the studio goes on."""
+        try:
+            options = self.planning.options()
+        except ValueError as exc:
+            self.notify("Planner options", str(exc))
+            return
+        self.client.add_notification("Drawing the animation", "40 frames, a few seconds",
+                                     auto_close_seconds=4.0)
+        threading.Thread(target=self._send_animation, args=(self.stage.problem, options),
+                         daemon=True, name="studio-gif").start()
+
+    def _send_animation(self, problem, options) -> None:
+        from app.animate import animation_gif
+
+        try:
+            gif = animation_gif(problem, options)
+        except ValueError as exc:  # e.g. a robot this steering cannot drive
+            self.notify("Animation", str(exc))
+            return
+        if not self._closed:
+            self.client.send_file_download("run.gif", gif, save_immediately=True)
 
     def notify(self, title: str, body: str) -> None:
         self.client.add_notification(title, body, auto_close_seconds=6.0, color="red")
