@@ -67,6 +67,7 @@ class Panel:
     reset: object
     drive: object
     raceline_download: object
+    animation_download: object
     status: object
     metrics: object
     extend: object
