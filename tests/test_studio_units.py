@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 
 import numpy as np
 import pytest
@@ -21,6 +22,15 @@ from planner.problem import resolve_track
 
 def _problem(name: str = "thesis"):
     return planner.compile_problem(planner.parse_scenario(default_scenario(name)))
+
+
+def _run_to_the_end(worker) -> None:
+    """Run the worker until its budget is spent (10 s at most), and a moment longer."""
+    worker.run()
+    deadline = time.monotonic() + 10
+    while worker.live.state != "done" and time.monotonic() < deadline:
+        time.sleep(0.01)
+    time.sleep(0.05)
 
 
 @pytest.mark.parametrize("name", ["thesis", "carolo", "slalom"])
@@ -177,17 +187,11 @@ def test_waypoints_text_is_rows_of_t_dx_dy():
 
 def test_a_run_that_ends_between_metric_updates_still_shows_its_last_numbers():
     """Metrics are throttled to two a second; a 300-iteration run ends well within one."""
-    import time
-
     from app.studio._worker import PlannerWorker
 
     worker = PlannerWorker(_problem(), planner.PlanOptions(seed=0), budget=300)
     try:
-        worker.run()
-        deadline = time.monotonic() + 10
-        while worker.live.state != "done" and time.monotonic() < deadline:
-            time.sleep(0.01)
-        time.sleep(0.05)
+        _run_to_the_end(worker)
         assert worker.live.state == "done"
         assert worker.live.metrics["iterations"] == 300
         assert worker.live.metrics["nodes"] == worker._run.nodes > 2
@@ -320,17 +324,12 @@ def test_an_svg_without_a_usable_path_says_why():
 
 
 def test_iterations_per_second_is_the_rate_achieved_under_the_speed_throttle():
-    import time
 
     from app.studio._worker import PlannerWorker
 
     worker = PlannerWorker(_problem(), planner.PlanOptions(seed=0), budget=100, rate=200.0)
     try:
-        worker.run()
-        deadline = time.monotonic() + 10
-        while worker.live.state != "done" and time.monotonic() < deadline:
-            time.sleep(0.02)
-        time.sleep(0.05)
+        _run_to_the_end(worker)
         assert worker.live.metrics["iterations_per_s"] == pytest.approx(200, rel=0.25)
     finally:
         worker.stop()
