@@ -41,7 +41,7 @@ from planner._world import World, motion_free, static_clearance_estimate
 
 # Parameter vector indices.
 (EPS, GAMMA, GOAL_BIAS, RHO, SPEED, GX, GY, GTH, GPOS, GHEAD, INFORMED, STAR, STEERING,
- SX, SY, K_RRT, DIMS, METRIC, NPARAMS) = range(19)
+ SX, SY, K_RRT, DIMS, METRIC, POLISH, NPARAMS) = range(20)
 STEERING_METRIC, SE2_METRIC = range(2)  # planner.options.METRICS
 LANE_SHARE, LANE_SIGMA = 0.9, 0.25  # track scenarios: headings sampled along the lane
 NEAREST_BUCKETS = 256  # nearest's queue: half-cell buckets, the last one takes the rest
@@ -703,7 +703,7 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
                 ev.cnt[2] += 1
         if changed:
             _update_best(tree)
-        if (P[STAR] > 0.0 and not timed and tree.cnt[BEST] >= 0
+        if (P[POLISH] > 0.0 and P[STAR] > 0.0 and not timed and tree.cnt[BEST] >= 0
                 and tree.cnt[ITER] >= tree.cnt[POLISH_AT]):
             # At the first solution, then at twice as many iterations each time.
             tree.cnt[POLISH_AT] = 2 * tree.cnt[ITER]

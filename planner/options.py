@@ -65,6 +65,9 @@ class PlanOptions(BaseModel):
         None, description="Informed sampling after the first solution [default: on for RRT*].")
     speed: Speed | None = Field(
         None, description="Planning speed v [m/s] [default: the scenario's vehicle.speed].")
+    polish: bool = Field(
+        True, description="Polish the best path's poses at the first solution and each "
+                          "doubling of the iterations (static scenes; docs/planner.md).")
     safety_margin: Margin | None = Field(
         None, description="Distance [m] the path keeps from every obstacle and boundary "
                           "[default: the scenario's vehicle.safety_margin].")

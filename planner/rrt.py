@@ -102,6 +102,7 @@ class Planner:
         P[K.K_RRT] = s.k_rrt or 0.0
         P[K.DIMS] = s.dimensions
         P[K.METRIC] = METRICS.index(s.metric)
+        P[K.POLISH] = float(s.polish)
         self._P = P
         zero = np.zeros(5)
         K.add_node(self._tree, P, *problem.start, 0.0, -1, zero.astype(np.int8), zero)

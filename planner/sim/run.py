@@ -150,7 +150,8 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     rng = np.random.default_rng(s.seed)
     fixed = s.fixed_latency_ms / 1000.0 if s.fixed_latency_ms is not None else None
     def new_replanner() -> Replanner:
-        return Replanner(problem, PlanOptions(seed=s.seed), seed=s.seed,
+        # No polishing: a cycle's budget is a few milliseconds, and the next cycle replans.
+        return Replanner(problem, PlanOptions(seed=s.seed, polish=False), seed=s.seed,
                          budget_s=s.budget_share / s.rate,
                          iterations=s.iterations if fixed is not None else None,
                          margin=s.margin)
