@@ -229,7 +229,7 @@ def test_a_safety_margin_is_kept_from_every_obstacle_and_wall():
     an independent check with the disc grown by the margin confirms."""
     scn = scenario_dict("hallway")
     scn["vehicle"] = {**scn.get("vehicle", {}), "safety_margin": 0.1}
-    result = planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=4000)
+    result = planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=2500)
     assert result.solved and result.min_clearance_m >= 0.1
     grown = {**scn, "vehicle": {**scn["vehicle"], "radius": scn["vehicle"]["radius"] + 0.1}}
     assert first_collision(grown, result.path[:, :3]) is None

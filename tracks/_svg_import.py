@@ -251,9 +251,9 @@ def _subpath_tracks(elem: _Element, unit_m: float, name: str, width_m: float) ->
     for sub in _segments(elem):
         segs = tuple(seg.transformed(linear, offset) for seg in sub)
         gap = np.hypot(*(segs[-1].end - segs[0].start)) if segs else 0.0
-        extent = max(
-            np.ptp(np.array([s.start for s in segs] + [segs[-1].end]), axis=0).max(), 1e-300
-        ) if segs else 0.0
+        # The size of the curve itself, not of its ends: one segment out and back is a loop.
+        extent = max(np.ptp(np.vstack([s.point(np.linspace(0.0, 1.0, 5)) for s in segs]),
+                            axis=0).max(), 1e-300) if segs else 0.0
         try:
             out.append(Track(name=name, closed=bool(gap <= 1e-9 * extent), width_m=width_m,
                              segments=segs))
