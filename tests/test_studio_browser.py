@@ -434,24 +434,6 @@ def test_a_scenario_saved_to_the_server_loads_back_with_its_track(browser, urls,
     other.close()
 
 
-def test_straight_line_steering_draws_the_classic_rrt_picture(browser, ui_url):
-    """The registry's third steering, chosen from the dropdown: straight edges, a path."""
-    page = open_tab(browser, ui_url)
-    page.get_by_label("Steering", exact=True).click(force=True)
-    page.get_by_role("option", name="Straight line").click(force=True)
-    blue = tree_pixels(canvas_pixels(page))
-    click(page, "Run")
-    wait_until(page, lambda img: tree_pixels(img) > blue + 2000, timeout=20)
-    time.sleep(1.0)
-    click(page, "Pause")
-    after = canvas_pixels(page, "13_straight_line")
-    assert pink_pixels(after) > 200, "no best path drawn"
-    assert "Error" not in page.get_by_text("Status:").first.inner_text()
-    # Its heading free, the robot goes the short way: a quarter lap back, not 3/4 ahead.
-    assert 2.0 < metric(page, "cost") < 6.0
-    page.close()
-
-
 def test_the_studies_folder_lists_the_servers_studies_opens_and_downloads_a_report(browser,
                                                                                    urls):
     import httpx
