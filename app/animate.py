@@ -39,6 +39,7 @@ class FrameRecorder:
         self.problem = None
 
     def __call__(self, planner) -> None:
+        planner = getattr(planner, "route", planner)  # timing optimal: the tree of the route
         self.problem = planner.problem
         self.frames.append(Frame(planner.snapshot(), planner.iterations, planner.best_cost))
 

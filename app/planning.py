@@ -17,6 +17,7 @@ from planner.report import PlanReport
 
 if TYPE_CHECKING:
     from planner.rrt import Planner
+    from planner.timing import TimeOptimalPlanner
 
 __all__ = ["TrackSource", "advance_in_parts", "check_scenario", "run_plan", "track_loader"]
 
@@ -55,7 +56,7 @@ def _compile(scenario, track: TrackSource | None):
     return core.compile_problem(scenario, load_track=track_loader(track))
 
 
-def advance_in_parts(planner: Planner, time_s: float | None, iterations: int | None,
+def advance_in_parts(planner: Planner | TimeOptimalPlanner, time_s: float | None, iterations: int | None,
                      parts: int, observe: Callable[[Planner], None] | None = None,
                      stop: Callable[[], bool] | None = None) -> None:
     """Spend the budget in ``parts`` equal parts, ``observe(planner)`` after each (an
@@ -98,7 +99,7 @@ def run_plan(scenario, options: PlanOptions, *, max_time: float | None = None,
     if budget_time is not None:
         planning_time = max(budget_time - (time.perf_counter() - started),
                             MIN_PLANNING_SHARE * budget_time)
-    planner = core.Planner(problem, options)
+    planner = core.planner_for(problem, options)
     advance_in_parts(planner, planning_time, options.iterations, chunks, observe, stop)
     result = planner.result()
     return plan_report(result, problem.scenario.name,

@@ -18,7 +18,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from app.planning import TrackSource, track_loader
-from planner.options import Seed
+from planner.options import TIMINGS, Seed
 
 __all__ = ["MAX_DURATION_S", "SimOptions", "SimulationStopped", "read_progress",
            "run_simulation"]
@@ -51,6 +51,9 @@ class SimOptions(BaseModel):
     fixed_latency_ms: Annotated[float, Field(ge=0, le=MAX_LATENCY_MS, allow_inf_nan=False)] | None = Field(
         None, description="a fixed cycle time instead of the measured one (reproducible logs)")
     replan: bool = Field(True, description="false: plan once at t = 0 and follow it blind")
+    timing: Literal[TIMINGS] = Field(
+        "constant", description="optimal: the car may stop for a mover on its path instead of "
+                                "going round it")
 
     def settings(self, **local):
         """The `planner.sim.SimSettings` of these options and of ``local`` ones (the command

@@ -30,6 +30,7 @@ if TYPE_CHECKING:
         scenario_schema,
     )
     from planner.steering import STEERINGS
+    from planner.timing import TimeOptimalPlanner, planner_for
     from planner.tree import Rewire, TreeEvents, TreeSnapshot
 
 _HOMES = {
@@ -39,13 +40,14 @@ _HOMES = {
     "Rewire": "tree", "TreeEvents": "tree", "TreeSnapshot": "tree",
     "Scenario": "scenario", "ScenarioError": "scenario", "bundled_scenario_path": "scenario",
     "load_scenario": "scenario", "parse_scenario": "scenario", "scenario_names": "scenario",
-    "scenario_schema": "scenario",
+    "scenario_schema": "scenario", "TimeOptimalPlanner": "timing", "planner_for": "timing",
 }
 
 __all__ = [
     "STEERINGS", "PlanOptions", "Planner", "Problem", "Result", "Rewire", "Scenario",
-    "ScenarioError", "TreeEvents", "TreeSnapshot", "bundled_scenario_path", "compile_problem", "load_scenario",
-    "parse_scenario", "scenario_names", "scenario_schema", "solve",
+    "ScenarioError", "TimeOptimalPlanner", "TreeEvents", "TreeSnapshot", "bundled_scenario_path",
+    "compile_problem", "load_scenario", "parse_scenario", "planner_for", "scenario_names",
+    "scenario_schema", "solve",
 ]
 
 
@@ -64,10 +66,10 @@ def solve(scenario: Scenario | Problem | str | os.PathLike, *, time_limit: float
     fields (``planner="rrt"``, ``steering="straight"``, …)."""
     from planner.options import PlanOptions
     from planner.problem import Problem, compile_problem
-    from planner.rrt import Planner
     from planner.scenario import load_scenario
+    from planner.timing import planner_for
 
     if isinstance(scenario, (str, os.PathLike)):
         scenario = load_scenario(scenario)
     problem = scenario if isinstance(scenario, Problem) else compile_problem(scenario)
-    return Planner(problem, PlanOptions(**options)).solve(time_limit, iterations)
+    return planner_for(problem, PlanOptions(**options)).solve(time_limit, iterations)

@@ -134,6 +134,24 @@ def inflated(world: World, margin: float) -> World:
     return world._replace(geo=geo, discs=discs)
 
 
+def without_movers(world: World) -> World:
+    """The same world with its moving obstacles left out: where a path may go at all, for a
+    planner that then chooses when to drive it (`planner.timing`)."""
+    keep_c = world.circ_motion < 0
+    keep_p = np.flatnonzero(world.poly_motion < 0)
+    counts = np.diff(world.poly_start)[keep_p]
+    edges = [world.poly_edges[world.poly_start[p]:world.poly_start[p + 1]] for p in keep_p]
+    geo = world.geo.copy()
+    geo[VMAX_OBS] = 0.0
+    return world._replace(
+        geo=geo, circ=world.circ[keep_c], circ_motion=world.circ_motion[keep_c],
+        poly_edges=np.vstack(edges) if edges else np.zeros((0, 4)),
+        poly_start=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
+        poly_bbox=world.poly_bbox[keep_p], poly_motion=world.poly_motion[keep_p],
+        m_kind=np.zeros(0, np.int64), m_vel=np.zeros((0, 2)), m_wp_start=np.zeros(1, np.int64),
+        m_wp=np.zeros((0, 3)))
+
+
 @njit(cache=True)
 def offset(w: World, m: int, t: float):
     """Translation (dx, dy) of motion ``m`` at time t (FORMAT.md v1.1 semantics)."""
@@ -277,6 +295,18 @@ def pose_clearance(w: World, x: float, y: float, th: float, t: float) -> float:
         d = _point_static(w, cx, cy)
         if t == t:
             d = _point_obstacles(w, cx, cy, t, True, d)
+        c = min(c, d - r)
+    return c
+
+
+@njit(cache=True)
+def moving_clearance(w: World, x: float, y: float, th: float, t: float) -> float:
+    """Clearance of the car's footprint at pose (x, y, th) from the moving obstacles alone,
+    where they are at time t (+inf without any)."""
+    c = math.inf
+    for k in range(w.discs.shape[0]):
+        a, r = w.discs[k, 0], w.discs[k, 1]
+        d = _point_obstacles(w, x + a * math.cos(th), y + a * math.sin(th), t, True, math.inf)
         c = min(c, d - r)
     return c
 

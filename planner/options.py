@@ -15,9 +15,10 @@ from pydantic import BaseModel, ConfigDict, Field
 from planner.scenario import Margin, ScenarioError, Speed
 from planner.steering import STEERINGS, SteeringName
 
-__all__ = ["METRICS", "PLANNERS", "PlanOptions", "PositiveFinite", "Seed"]
+__all__ = ["METRICS", "PLANNERS", "TIMINGS", "PlanOptions", "PositiveFinite", "Seed"]
 
 PLANNERS = ("rrt", "rrtstar")
+TIMINGS = ("constant", "optimal")
 METRICS = ("steering", "se2")  # the kernel's codes are their positions
 DEFAULT_TIME_S = 1.0
 # Limits no honest run reaches (the time budget is capped by the server's --max-plan-s).
@@ -68,6 +69,10 @@ class PlanOptions(BaseModel):
     polish: bool = Field(
         True, description="Polish the best path's poses at the first solution and each "
                           "doubling of the iterations (static scenes; docs/planner.md).")
+    timing: Literal[TIMINGS] = Field(
+        "constant", description="constant: drive the path at the planning speed; optimal: "
+                                "any speed up to vehicle.max_speed, stopping allowed, and the "
+                                "objective is the arrival time (waits for movers).")
     safety_margin: Margin | None = Field(
         None, description="Distance [m] the path keeps from every obstacle and boundary "
                           "[default: the scenario's vehicle.safety_margin].")
@@ -114,6 +119,9 @@ class PlanOptions(BaseModel):
             gamma = 2.4 * (2.0 * (1.0 + 1.0 / d) * measure / unit_ball) ** (1.0 / d)
         informed = self.informed if self.informed is not None else self.planner == "rrtstar"
         speed = self.speed if self.speed is not None else problem.speed
+        if self.timing == "optimal" and speed > problem.top_speed:
+            raise ScenarioError(f"speed: {speed:g} m/s is above vehicle.max_speed "
+                                f"({problem.top_speed:g} m/s), the most timing optimal drives")
         margin = self.safety_margin if self.safety_margin is not None else problem.margin
         return self.model_copy(update={"eps": eps, "gamma": gamma, "informed": informed,
                                        "speed": speed, "safety_margin": margin})

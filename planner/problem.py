@@ -34,6 +34,12 @@ class Problem:
     speed: float
     timed: bool
     margin: float = 0.0  # the vehicle's safety margin: planned paths keep it
+    max_speed: float | None = None  # the vehicle's top speed (None: ``speed``)
+
+    @property
+    def top_speed(self) -> float:
+        """The fastest the car may drive (timing optimal): vehicle.max_speed, else speed."""
+        return self.max_speed if self.max_speed is not None else self.speed
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
@@ -138,7 +144,8 @@ def compile_problem(scenario: Scenario, load_track=None) -> Problem:
         scenario=scenario, world=world, start=tuple(scenario.start), goal=tuple(scenario.goal),
         goal_position_tol=tol.position, goal_heading_tol=math.radians(tol.heading_deg),
         rho=scenario.vehicle.turning_radius, speed=scenario.vehicle.speed,
-        timed=scenario.has_motion, margin=scenario.vehicle.safety_margin)
+        timed=scenario.has_motion, margin=scenario.vehicle.safety_margin,
+        max_speed=scenario.vehicle.max_speed)
     check_room(problem, problem.margin)
     return problem
 

@@ -16,14 +16,21 @@ class PlanReport(BaseModel):
 
     scenario: str
     solved: bool
-    cost: float | None = Field(description="driven length of the best path (m)")
+    cost: float | None = Field(description="the objective's value for the best path: its "
+                                           "driven length (m), or with timing optimal its "
+                                           "arrival time (s)")
+    objective: str = Field("length", description="what cost measures: length or time")
+    length_m: float | None = Field(None, description="driven length of the best path (m)")
+    waited_s: float | None = Field(None, description="time the car stands still on the path "
+                                                     "(timing optimal)")
     time_to_first_solution_s: float | None
     iterations: int
     nodes: int
     collision_checks: int = Field(description="motion checks (each exact, over a whole edge)")
     min_clearance_m: float | None = Field(description="over the path, every 5 mm, in space-time")
     max_abs_curvature: float | None
-    arrival_time_s: float | None = Field(None, description="only with moving obstacles")
+    arrival_time_s: float | None = Field(None, description="with moving obstacles or timing "
+                                                            "optimal")
     planning_time_s: float
     rewires: int
     refused_rewires: int = Field(description="rewires refused: the subtree would collide at "
@@ -31,8 +38,10 @@ class PlanReport(BaseModel):
     cost_over_time: list[tuple[float, float, int]] = Field(
         description="[t_s, cost, iteration] at each improvement of the best cost: the iteration "
                     "is exact for a seed, the time interpolated inside its batch")
-    path: list[list[float]] = Field(description="[x, y, theta] (plus t with moving obstacles) "
-                                                "every ≤ 0.05 m from the start to the goal node")
+    path: list[list[float]] = Field(description="[x, y, theta] (plus t with moving obstacles or "
+                                                "timing optimal) every ≤ 0.05 m (and ≤ 0.1 s "
+                                                "with timing optimal) from the start to the "
+                                                "goal node")
     parameters: dict
 
 
@@ -46,11 +55,13 @@ def plan_report(result: Result, scenario_name: str, budget: dict) -> PlanReport:
     path = result.path[:, columns].round(6).tolist() if result.solved else []
     return PlanReport(
         scenario=scenario_name, solved=result.solved, cost=_clean(result.cost),
+        objective=result.objective, length_m=_clean(result.length_m),
+        waited_s=result.waited_s if result.objective == "time" and result.solved else None,
         time_to_first_solution_s=_clean(result.time_to_first_solution_s),
         iterations=result.iterations, nodes=result.nodes,
         collision_checks=result.collision_checks, min_clearance_m=_clean(result.min_clearance_m),
         max_abs_curvature=_clean(result.max_abs_curvature),
-        arrival_time_s=(float(result.path[-1, 5]) if result.timed and result.solved else None),
+        arrival_time_s=result.arrival_time_s if result.timed else None,
         planning_time_s=result.planning_time_s, rewires=result.rewires,
         refused_rewires=result.refused_rewires,
         cost_over_time=[(round(t, 6), c, i) for t, c, i in result.cost_over_time], path=path,

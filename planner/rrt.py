@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from planner import _kernel as K
-from planner._paths import pose_at, sample_path
+from planner._paths import TURN, advance, pose_at, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
 from planner._world import inflated, path_clearances
@@ -47,8 +47,15 @@ class Result:
     max_abs_curvature: float | None
     cost_over_time: list[tuple[float, float, int]]  # (t_s, best cost, iteration) per improvement
     path: np.ndarray  # (n, 6): x, y, theta, curvature, direction, t
-    timed: bool
+    timed: bool  # the path's t column is the schedule (movers, or timing optimal)
     options: PlanOptions  # as resolved for the problem
+    objective: str = "length"  # what ``cost`` measures: "length" (m) or "time" (s, arrival)
+    length_m: float | None = None  # the path's driven length
+    waited_s: float = 0.0  # time standing still on the path
+
+    @property
+    def arrival_time_s(self) -> float | None:
+        return float(self.path[-1, 5]) if self.solved else None
 
     def cost_at(self, t: float) -> float | None:
         """Best cost found within the first ``t`` seconds, or None."""
@@ -265,6 +272,29 @@ class Planner:
         driven = np.concatenate([[0.0], np.cumsum(_step_lengths(pts))])
         return np.column_stack([pts, driven / self.options.speed])
 
+    def best_path_segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The best path as its driven segments: start poses (m, 3), kinds, signed lengths and
+        the driven length where each starts (a turn on the spot is folded into the pose that
+        follows it)."""
+        t, rho = self._tree, self.problem.rho
+        poses, kinds, lens, starts = [], [], [], []
+        driven = 0.0
+        for node in self.best_path_nodes()[1:]:
+            x, y, th = t.pose[t.parent[node]]
+            for kind, seg in zip(t.kinds[node], t.lens[node]):
+                if seg != 0.0 and kind != TURN:
+                    poses.append((x, y, th))
+                    kinds.append(kind)
+                    lens.append(seg)
+                    starts.append(driven)
+                    driven += abs(seg)
+                if seg != 0.0:
+                    x, y, th = advance(x, y, th, kind, seg, rho)
+        if not poses:  # the start is in the goal region
+            poses, kinds, lens, starts = [self.root], [0], [0.0], [0.0]
+        return (np.array(poses, dtype=float), np.array(kinds, dtype=np.int64),
+                np.array(lens, dtype=float), np.array(starts, dtype=float))
+
     @property
     def root(self) -> tuple[float, float, float]:
         """The root's pose (x, y, θ)."""
@@ -329,7 +359,7 @@ class Planner:
             planning_time_s=self._compute_time, min_clearance_m=min_clear,
             max_abs_curvature=float(np.abs(path[:, 3]).max()) if solved else None,
             cost_over_time=list(self._clock.cost_over_time), path=path,
-            timed=self.problem.timed, options=self.options)
+            timed=self.problem.timed, options=self.options, length_m=self.best_cost)
 
 
 def _named(ev: K.Events) -> TreeEvents:

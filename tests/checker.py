@@ -177,12 +177,15 @@ def pose_valid(scn: dict, x: float, y: float, t: float | None,
     return True
 
 
-def densify(path: np.ndarray, step: float = 0.005) -> np.ndarray:
-    """Rows x, y, theta[, t] every ≤ step, each gap filled by the arc its end poses define."""
+def densify(path: np.ndarray, step: float = 0.005, time_step: float = 0.005) -> np.ndarray:
+    """Rows x, y, theta[, t] every ≤ step and ≤ time_step, each gap filled by the arc its end
+    poses define (a wait, where both poses are the same, by instants)."""
     out = [path[:1]]
     for p, q in zip(path[:-1], path[1:]):
         chord = math.hypot(q[0] - p[0], q[1] - p[1])
         n = max(1, math.ceil(chord / step))
+        if path.shape[1] > 3:
+            n = max(n, math.ceil((q[3] - p[3]) / time_step))
         f = np.arange(1, n + 1) / n
         dth = (q[2] - p[2] + math.pi) % (2 * math.pi) - math.pi
         th = p[2] + f * dth
@@ -230,3 +233,28 @@ def arc_mismatch(path) -> float:
         err = abs((chord_dir - mid + math.pi / 2) % math.pi - math.pi / 2)
         worst = max(worst, err)
     return worst
+
+
+def schedule_errors(path, max_speed: float) -> list[str]:
+    """FORMAT.md v1.3's rules for a timed path of ``timing: optimal``: t from 0 and
+    non-decreasing, at most ``max_speed`` between entries (1 % tolerance), entries at most
+    0.05 m and 0.1 s apart. Returns one message per kind of breach."""
+    path = np.asarray(path, dtype=float)
+    step = np.hypot(*np.diff(path[:, :2], axis=0).T)
+    dt = np.diff(path[:, 3])
+    errors = []
+    if path[0, 3] != 0.0:
+        errors.append(f"the first entry is at t = {path[0, 3]}, not 0")
+    if (dt < 0).any():
+        errors.append(f"t decreases after entry {int(np.argmax(dt < 0))}")
+    moving = step > 1e-9
+    fast = moving & (step > 1.01 * max_speed * np.maximum(dt, 0.0))
+    if fast.any():
+        k = int(np.argmax(fast))
+        errors.append(f"entry {k} to {k + 1}: {step[k]:.4f} m in {dt[k]:.4f} s is above "
+                      f"{max_speed} m/s")
+    if (step > 0.05 + 1e-9).any():
+        errors.append(f"entries up to {step.max():.4f} m apart")
+    if (dt > 0.1 + 1e-9).any():
+        errors.append(f"entries up to {dt.max():.4f} s apart")
+    return errors

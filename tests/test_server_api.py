@@ -336,6 +336,8 @@ def test_plan_by_id_on_an_uploaded_track(server):
     ({"scenario": {}, "planner": "prm"}, "rrtstar"),
     ({"scenario": {}, "goal_bias": 1.5}, "less than 1"),
     ({"scenario": {}, "colour": "red"}, "colour"),
+    ({"scenario": {}, "timing": "fast"}, "timing"),
+    ({"scenario_id": "train", "timing": "optimal", "speed": 2.5}, "above vehicle.max_speed"),
 ])
 def test_bad_plan_options_are_422(server, body, words):
     resp = server.client.post("/plan", json=body)

@@ -182,6 +182,16 @@ def test_replanning_passes_movers_a_blind_plan_hits(scene):
     assert blind.summary["min_clearance_m"] < 0
 
 
+def test_with_timing_optimal_the_car_waits_for_the_train():
+    """At the level crossing the car stops beside the rails until the train has passed (a
+    planned wait, no emergency stop), instead of looping as the constant-timing car must."""
+    scn, run = _run("train", duration=30.0, seed=1, timing="optimal")
+    s = run.summary
+    assert s["reached_goal"] and s["collisions"] == 0 and _independent_collisions(scn, run.log) == 0
+    assert s["planned_waits"] >= 1 and s["emergency_stops"] == 0
+    assert s["distance_m"] < 18.5  # straight on: no loop
+
+
 # -- the command line ----------------------------------------------------------------------
 def _cli(*args, timeout=120):
     return subprocess.run(["trackstar", "simulate", *map(str, args)], check=False,
@@ -235,7 +245,7 @@ def _with(tmp_path, name="crossing", **changes):
 @pytest.mark.parametrize("args, needle", [
     (["--rate", "0"], "--rate"), (["--duration", "-1"], "--duration"),
     (["--control-rate", "nan"], "--control-rate"), (["--controller", "lqr"], "--controller"),
-    (["--sense-rate", "0"], "--sense-rate"),
+    (["--sense-rate", "0"], "--sense-rate"), (["--timing", "fastest"], "--timing"),
 ])
 def test_cli_rejects_bad_options(args, needle):
     r = _cli("crossing", *args, timeout=30)

@@ -71,14 +71,19 @@ def _print_summary(report) -> None:
         typer.echo(f"  not solved within the budget ({report.iterations} iterations, "
                    f"{report.nodes} nodes)")
         return
-    typer.echo(f"  cost {report.cost:.3f} m, first solution after "
-               f"{1000 * report.time_to_first_solution_s:.1f} ms")
+    if report.objective == "time":
+        typer.echo(f"  arrives after {report.cost:.2f} s (waiting {report.waited_s:.2f} s) on a "
+                   f"path of {report.length_m:.3f} m, first solution after "
+                   f"{1000 * report.time_to_first_solution_s:.1f} ms")
+    else:
+        typer.echo(f"  cost {report.cost:.3f} m, first solution after "
+                   f"{1000 * report.time_to_first_solution_s:.1f} ms")
     stop = " (RRT stops at its first solution; RRT* improves it)" if p["planner"] == "rrt" else ""
     typer.echo(f"  {report.iterations} iterations{stop}, {report.nodes} nodes, "
                f"{report.collision_checks} motion checks, {report.rewires} rewires")
     typer.echo(f"  min clearance {report.min_clearance_m:.3f} m, "
                f"max |curvature| {report.max_abs_curvature:.3f} 1/m")
-    if report.arrival_time_s is not None:
+    if report.arrival_time_s is not None and report.objective != "time":
         typer.echo(f"  arrives at t = {report.arrival_time_s:.2f} s")
 
 

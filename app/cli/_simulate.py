@@ -34,6 +34,9 @@ def simulate(
              "the same log, byte for byte.")] = None,
     no_replan: Annotated[bool, typer.Option(
         "--no-replan", help="Plan once at t = 0 and follow that plan blind.")] = False,
+    timing: Annotated[str, typer.Option(
+        help="constant or optimal: the car may stop for a mover on its path instead of going "
+             "round it (when it can go on within 10 s).")] = "constant",
     realtime: Annotated[bool, typer.Option(help="Pace the run to the wall clock.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     log: Annotated[Path | None, typer.Option(help="Write the per-tick log (CSV).")] = None,
@@ -56,7 +59,7 @@ def simulate(
         settings = SimOptions(duration=duration, rate=rate, control_rate=control_rate,
                               sense_rate=sense_rate, controller=controller, noise=noise,
                               seed=seed, fixed_latency_ms=fixed_latency, replan=not no_replan,
-                              laps=laps).settings(realtime=realtime)
+                              laps=laps, timing=timing).settings(realtime=realtime)
         problem = core.compile_problem(core.load_scenario(scenario))
         for name, out in (("--log", log), ("--raceline", raceline)):
             if out is not None and not out.parent.is_dir():
@@ -91,7 +94,7 @@ def _print_summary(name: str, s: dict) -> None:
         typer.echo(f"  behaviour: {len(b['transitions'])} transitions, "
                    f"final state '{b['final_state']}'")
     typer.echo(f"  collisions {s['collisions']}, min clearance {s['min_clearance_m']:.3f} m, "
-               f"emergency stops {s['emergency_stops']}")
+               f"emergency stops {s['emergency_stops']}, planned waits {s['planned_waits']}")
     c = s["cycle_ms"]
     if c["p50"] is not None:
         typer.echo(f"  {s['cycles']} cycles, {s['replans']} replans; cycle ms p50 {c['p50']:.1f}"

@@ -34,7 +34,8 @@ __all__ = ["PARAMETERS", "SIM_PARAMETERS", "Run", "SimRun", "Study", "StudyError
 
 # The axes a study may sweep: `trackstar plan`'s and `trackstar simulate`'s options, under the
 # same names.
-PARAMETERS = ("eps", "gamma", "k_rrt", "goal_bias", "informed", "metric", "speed")
+PARAMETERS = ("eps", "gamma", "k_rrt", "goal_bias", "informed", "metric", "speed", "polish",
+              "timing")
 SIM_PARAMETERS = tuple(k for k in SimOptions.model_fields if k != "seed")
 _RRTSTAR_ONLY = ("gamma", "k_rrt", "informed")
 TARGETS = (*PLANNERS, *OMPL_PLANNERS)  # ours, and OMPL's with the bench extra

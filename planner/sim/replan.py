@@ -18,13 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from planner._paths import pose_at
-from planner._world import clearance, inflated, path_clearances
+from planner._world import clearance, inflated, path_clearances, without_movers
 from planner.options import PlanOptions
 from planner.problem import Problem
 from planner.rrt import Planner
 from planner.sim.control import Reference
 from planner.sim.predict import predicted_world
 from planner.sim.sensing import Sensing
+from planner.timing import fastest_schedule
 
 __all__ = ["Cycle", "Replanner", "warm_up"]
 
@@ -36,6 +37,9 @@ GOAL_SHARE = 0.6
 # Re-rooting keeps nodes that could lie on a path at most this much longer than the current
 # plan (informed pruning with slack: alternatives for when the plan becomes blocked).
 PRUNE_FACTOR, PRUNE_SLACK = 1.5, 2.0
+# Timing optimal: the car waits for movers on its path if it can go on within this long;
+# otherwise it plans round them, as with constant timing.
+PATIENCE_S = 10.0
 
 
 @dataclass(frozen=True)
@@ -46,6 +50,7 @@ class Cycle:
     replaced: bool
     stop_s: float  # arc on the delivered (or kept) reference where the car must be at rest
     conflict: bool  # stop_s comes from a predicted conflict, not the end of the trajectory
+    planned_wait: bool  # timing optimal: the plan waits at such a conflict, it is no emergency
     wall_s: float
     nodes: int
 
@@ -94,8 +99,7 @@ class Replanner:
             free = [g for g in self.goals if clearance(plan_world, g[0], g[1], 0.0) > 0.0]
             self.problem = dataclasses.replace(self.problem, goal=(free or self.goals)[0])
         old, old_cost = self.planner, self._remaining_cost(s_c)
-        planner = self._new_planner(plan_world, root, old, anchor, skip)
-        self._grow(planner, started)
+        planner, waits = self._plan(plan_world, root, old, anchor, skip, started)
         replaced = False
         self.shift = 0.0
         if planner.solved:
@@ -110,7 +114,23 @@ class Replanner:
             self.root_s = s_c
         stop_s, conflict = self._stop_point(believed, t, lead_s, s_now)
         return Cycle(self.reference if planner.solved else None, replaced, stop_s, conflict,
-                     time.perf_counter() - started, planner.nodes)
+                     waits and conflict, time.perf_counter() - started, planner.nodes)
+
+    def _plan(self, world, root, old, anchor: int, skip: float, started: float):
+        """(the cycle's tree, whether its path waits for movers). With timing optimal the tree
+        is grown among the static obstacles, and the car stops for a mover on its path (the
+        governor's conflict stop) as long as a schedule along it goes on within `PATIENCE_S`;
+        otherwise the cycle plans round the movers in space-time after all."""
+        if self.options.timing == "optimal":
+            planner = self._new_planner(without_movers(world), root, old, anchor, skip)
+            self._grow(planner, started)
+            if not planner.solved or fastest_schedule(planner, world, self.options.speed,
+                                                      PATIENCE_S) is not None:
+                return planner, planner.solved
+            started = time.perf_counter()  # planning round them gets a budget of its own
+        planner = self._new_planner(world, root, old, anchor, skip)
+        self._grow(planner, started)
+        return planner, False
 
     def _commit_point(self, pose, s_now: float, commit: float):
         """(root pose, anchor node, skip, arc) of the state ``commit`` metres ahead."""

@@ -17,7 +17,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from planner._world import path_clearances
-from planner.options import PlanOptions
+from planner.options import TIMINGS, PlanOptions
 from planner.problem import Problem, compile_problem, resolve_track
 from planner.rrt import warm_up
 from planner.scenario import Scenario
@@ -52,6 +52,7 @@ class SimSettings:
     iterations: int = 80  # planner iterations per cycle under a fixed latency
     margin: float = 0.05  # m added to the car's radius when planning
     realtime: bool = False
+    timing: str = "constant"  # optimal: the car may stop for a mover instead of going round
     laps: int | None = None  # lap mode: drive this many laps of the scenario's closed track
     goal_ahead: float = 3.0  # m of centreline arc between the car and its rolling goal (laps)
 
@@ -61,6 +62,8 @@ class SimSettings:
             if not (math.isfinite(v) and v > 0):
                 raise ValueError(f"--{name.replace('_', '-')} must be a finite number > 0, "
                                  f"got {v}")
+        if self.timing not in TIMINGS:
+            raise ValueError(f"--timing must be one of {', '.join(TIMINGS)}, got {self.timing!r}")
         if self.controller not in CONTROLLERS:
             raise ValueError(f"unknown controller '{self.controller}' "
                              f"(use one of {', '.join(CONTROLLERS)})")
@@ -151,17 +154,20 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     fixed = s.fixed_latency_ms / 1000.0 if s.fixed_latency_ms is not None else None
     def new_replanner() -> Replanner:
         # No polishing: a cycle's budget is a few milliseconds, and the next cycle replans.
-        return Replanner(problem, PlanOptions(seed=s.seed, polish=False), seed=s.seed,
+        return Replanner(problem, PlanOptions(seed=s.seed, polish=False, timing=s.timing,
+                                              speed=cruise if fsm is None else None),
+                         seed=s.seed,
                          budget_s=s.budget_share / s.rate,
                          iterations=s.iterations if fixed is not None else None,
                          margin=s.margin)
 
-    replanner = new_replanner()
     fsm = Behaviour(behaviour, problem.world, limits.wheelbase, dt) if behaviour else None
+    # FollowTrack caps its own speed; timing optimal drives as fast as the car may.
+    cruise = vehicle.speed if fsm is None and s.timing == "constant" else limits.max_speed
+    replanner = new_replanner()
     gains = Tracking()
     # Heading noise as if θ came from two position fixes a wheelbase apart.
     pose_sigma = (s.noise, s.noise, math.sqrt(2.0) * s.noise / limits.wheelbase)
-    cruise = vehicle.speed if fsm is None else limits.max_speed  # FollowTrack caps its own
     x, y, th = problem.start
     est = (x, y, th)
     v = steer = 0.0
@@ -169,7 +175,8 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     sensing, j_sense = None, 0
     ref, stop_s, conflict = None, 0.0, False
     pending, next_cycle = None, 0.0 if fsm is None or fsm.planning else math.inf
-    walls, cycles, replans, stops, was_stopped = [], [], 0, 0, False
+    walls, cycles, replans, stops, waits, was_stopped = [], [], 0, 0, 0, False
+    planned = False  # the current stop is a planned wait (timing optimal), not an emergency
     rows, lat = [], []
     tree_of, tree = None, None  # the planner last shown to the observer, and its copy
     wall0 = time.perf_counter()
@@ -188,6 +195,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
             if cyc.reference is not None:
                 ref = cyc.reference
             stop_s, conflict = cyc.stop_s, cyc.conflict and s.replan
+            planned = cyc.planned_wait
             replans += cyc.replaced
             pending = None
         if pending is None and t >= next_cycle - 1e-9 and (
@@ -223,7 +231,8 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
         v_cmd, steer_cmd = limit_commands(v, steer, want_v, want_steer, limits, dt)
         e_old = e
         stopped = ref is not None and conflict and abs(v_cmd) < 1e-9
-        stops += stopped and not was_stopped
+        stops += stopped and not was_stopped and not planned
+        waits += stopped and not was_stopped and planned
         was_stopped = stopped
         rows.append((t, x, y, th, v_cmd, steer_cmd, want_steer, e,
                      replanner.planner.nodes if replanner.planner else 0))
@@ -272,6 +281,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
         "replans": int(replans),
         **cycle_stats(walls),
         "emergency_stops": int(stops),
+        "planned_waits": int(waits),
         "cross_track_error_m": {"mean": float(lat.mean()) if len(lat) else None,
                                 "max": float(lat.max()) if len(lat) else None},
         "distance_m": float(np.abs(log[:, 4]).sum() * dt) - float(abs(log[-1, 4]) * dt),
