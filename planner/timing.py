@@ -151,6 +151,11 @@ class TimeOptimalPlanner:
     def finished(self) -> bool:
         return all(p.finished for p in self.planners)
 
+    def step(self, iterations: int = 1) -> None:
+        """Each tree advances by ``iterations`` (the studio steps a run in small batches)."""
+        for planner in self.planners:
+            planner.step(iterations)
+
     def advance(self, time_limit: float | None = 1.0, iterations: int | None = None,
                 stop: Callable[[], bool] | None = None) -> None:
         """Each tree gets the iteration budget, and an equal share of the time."""
