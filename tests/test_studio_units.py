@@ -199,6 +199,30 @@ def test_a_run_that_ends_between_metric_updates_still_shows_its_last_numbers():
         worker.stop()
 
 
+def test_timing_optimal_shows_the_schedule_and_drive_car_stands_still_through_its_wait():
+    """The level crossing: the path shown is the run's result, the car waiting for the train;
+    Drive car holds the pose of the wait's start while the scene time runs on."""
+    from app.studio._planner_run import _metrics_md, pose_at_time
+    from app.studio._worker import PlannerWorker
+
+    problem = planner.compile_problem(planner.load_scenario("train"))
+    worker = PlannerWorker(problem, planner.PlanOptions(seed=3, timing="optimal"), budget=1500)
+    try:
+        _run_to_the_end(worker)
+        path, m = worker.live.best_path, worker.live.metrics
+    finally:
+        worker.stop()
+    assert worker.live.error is None and worker._run.detour.iterations == 1500
+    assert m["waited_s"] > 10.0 and m["arrival_s"] == pytest.approx(path[-1, 5])
+    assert f"| arrives after | {m['arrival_s']:.3g} s (waits {m['waited_s']:.3g} s) |" in (
+        _metrics_md(m))
+    still = np.flatnonzero(np.all(np.diff(path[:, :3], axis=0) == 0.0, axis=1))  # i to i + 1
+    assert np.diff(path[:, 5])[still].sum() == pytest.approx(m["waited_s"])
+    for i in still:
+        for t in np.linspace(path[i, 5], path[i + 1, 5], 3):
+            assert pose_at_time(path, t) == tuple(path[i, :3])
+
+
 def test_an_uploaded_csv_track_is_offered_shown_and_embedded_with_its_side_widths():
     from types import SimpleNamespace
 
@@ -342,6 +366,7 @@ def test_a_negative_budget_is_refused_with_the_models_message():
 
     ui = SimpleNamespace(planner_name=SimpleNamespace(value="RRT*"),
                          steering=SimpleNamespace(value=next(iter(STEERINGS))),
+                         timing=SimpleNamespace(value="constant speed"),
                          eps=SimpleNamespace(value=0.0), gamma=SimpleNamespace(value=0.0),
                          k_rrt=SimpleNamespace(value=0.0), goal_bias=SimpleNamespace(value=0.05),
                          seed=SimpleNamespace(value=0), budget=SimpleNamespace(value=-5))

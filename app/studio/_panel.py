@@ -9,10 +9,12 @@ import tracks
 from app.studio._extend import FIRST_NOTE, render
 from app.studio._vehicle import APPLIED, FOOTPRINTS
 
-__all__ = ["DEFAULT_BUDGET", "MOTIONS", "PLANNERS", "SPEEDS", "STEERINGS", "Panel", "build_panel"]
+__all__ = ["DEFAULT_BUDGET", "MOTIONS", "PLANNERS", "SPEEDS", "STEERINGS", "TIMINGS", "Panel",
+           "build_panel"]
 
 PLANNERS = {"RRT*": "rrtstar", "RRT": "rrt"}
 STEERINGS = {s.label: s.name for s in planner.STEERINGS.values()}
+TIMINGS = {"constant speed": "constant", "fastest arrival (may wait)": "optimal"}
 MOTIONS = ("static", "velocity", "waypoints", "follow track")
 DEFAULT_BUDGET = 30000  # iterations
 SPEEDS = {"max": None, "2000 it/s": 2000.0, "200 it/s": 200.0, "20 it/s": 20.0}
@@ -54,6 +56,7 @@ class Panel:
     vehicle_note: object
     planner_name: object
     steering: object
+    timing: object
     eps: object
     gamma: object
     k_rrt: object
@@ -129,6 +132,12 @@ def build_panel(gui) -> Panel:
     with gui.add_folder("Planner"):
         planner_name = gui.add_dropdown("Planner", tuple(PLANNERS), initial_value="RRT*")
         steering = gui.add_dropdown("Steering", tuple(STEERINGS))
+        timing = gui.add_dropdown(
+            "Timing", tuple(TIMINGS), initial_value="constant speed",
+            hint="Constant speed: the car drives the path at the vehicle's speed. Fastest "
+                 "arrival: at any speed up to the vehicle's max_speed, standing still too; the "
+                 "plan arriving first, which waits for a moving obstacle when that beats going "
+                 "round it")
         eps = gui.add_number("ε (step length, m; 0 = auto)", 0.0, min=0.0, step=0.05,
                              hint="The longest edge one iteration adds; auto: 15 % of the "
                                   "track's size, at least two turning radii")

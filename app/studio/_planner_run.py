@@ -19,14 +19,14 @@ import tracks
 from app.raceline import path_raceline, raceline_limits
 from app.studio._extend import FIRST_NOTE, explain, render
 from app.studio._live_view import LiveView
-from app.studio._panel import DEFAULT_BUDGET, PLANNERS, SPEEDS, STEERINGS
+from app.studio._panel import DEFAULT_BUDGET, PLANNERS, SPEEDS, STEERINGS, TIMINGS
 from app.studio._plots import Profiles
 from app.studio._scenario import goal_fraction
 from app.studio._scene import draw_car, marker_size, yaw_wxyz
 from app.studio._worker import PlannerWorker
 from planner.validation import describe
 
-__all__ = ["PlannerRun"]
+__all__ = ["PlannerRun", "pose_at_time"]
 
 PLOT_S = 1.0  # profile plots redraw at most this often (uPlot re-renders all of it)
 
@@ -64,8 +64,9 @@ class PlannerRun:
         try:
             return planner.PlanOptions(
                 planner=PLANNERS[u.planner_name.value], steering=STEERINGS[u.steering.value],
-                eps=u.eps.value or None, gamma=u.gamma.value or None,
-                k_rrt=u.k_rrt.value or None, goal_bias=float(u.goal_bias.value),
+                timing=TIMINGS[u.timing.value], eps=u.eps.value or None,
+                gamma=u.gamma.value or None, k_rrt=u.k_rrt.value or None,
+                goal_bias=float(u.goal_bias.value),
                 seed=int(u.seed.value), iterations=int(u.budget.value))
         except ValidationError as exc:
             raise ValueError(describe(exc).replace("iterations:", "Budget:")) from None
@@ -132,12 +133,11 @@ class PlannerRun:
         return float(path[-1, 5]) if path is not None and len(path) else None
 
     def show_car(self, t: float) -> None:
-        """The driving car where the best path is at time t (its column 5)."""
+        """The driving car where the best path is at time t."""
         path = self.worker.live.best_path if self.worker is not None else None
         if not self._driving or path is None or not len(path):
             return
-        k = int(np.searchsorted(path[:, 5], t).clip(0, len(path) - 1))
-        x, y, th = (float(v) for v in path[k, :3])
+        x, y, th = pose_at_time(path, t)
         if self._car is None:
             problem = self.stage.problem
             self._car = draw_car(self.scene, "/live/car", problem.scenario.vehicle,
@@ -170,6 +170,13 @@ class PlannerRun:
                                                   + note)
 
 
+def pose_at_time(path: np.ndarray, t: float) -> tuple[float, float, float]:
+    """The pose (x, y, θ) on a path's rows at time t, by their t column: through a wait (rows of
+    one pose, t rising) the car stands still."""
+    k = int(np.searchsorted(path[:, 5], t).clip(0, len(path) - 1))
+    return tuple(float(v) for v in path[k, :3])
+
+
 def _fmt(v, unit: str = "", digits: int = 3) -> str:
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "—"
@@ -179,12 +186,15 @@ def _fmt(v, unit: str = "", digits: int = 3) -> str:
 def _metrics_md(m: dict) -> str:
     if not m:
         return "—"
+    arrival = [] if m.get("arrival_s") is None else [  # timing optimal, once solved
+        f"| arrives after | {_fmt(m['arrival_s'], ' s')} (waits {_fmt(m['waited_s'], ' s')}) |"]
     return "\n".join([
         f"| iterations | {m['iterations']} |", "|---|---|",
         f"| nodes | {m['nodes']} |",
         f"| rewires | {m['rewires']} |",
         f"| time to first solution | {_fmt(m['time_to_first_solution_s'], ' s')} |",
         f"| cost | {_fmt(m['cost'], ' m', 4)} |",
+        *arrival,
         f"| min clearance | {_fmt(m['min_clearance_m'], ' m')} |",
         f"| iterations/s | {_fmt(m['iterations_per_s'], '', 4)} |",
     ])

@@ -92,8 +92,8 @@ class Session:
         u.scenario_upload.on_upload(lambda _: src.scenario_uploaded())
         u.scenario_save.on_click(lambda _: src.save_to_server())
         u.scenario_load.on_click(lambda _: src.load_from_server())
-        for control in (u.planner_name, u.steering, u.eps, u.gamma, u.k_rrt, u.goal_bias,
-                        u.budget, u.seed):
+        for control in (u.planner_name, u.steering, u.timing, u.eps, u.gamma, u.k_rrt,
+                        u.goal_bias, u.budget, u.seed):
             control.on_update(lambda _: self._locked(run.reset))
         u.reset.on_click(lambda _: self._locked(run.reset))
         u.rate.on_update(lambda _: run.set_rate())

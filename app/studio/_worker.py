@@ -3,6 +3,10 @@
 The planner is stepped in short batches (~5 ms) so the UI thread gets the GIL between them;
 its listener (on this thread, where reading the tree is safe) turns kernel events into edges,
 rewire flashes, the best path and metrics in a `Live` record the UI polls.
+
+With ``timing: optimal`` the run is a `planner.TimeOptimalPlanner`: its route tree is the one
+drawn, its detour tree grows alongside, and the best path shown is the run's result — the
+chosen schedule, waits included — so that Drive car and the profiles show what it would drive.
 """
 
 from __future__ import annotations
@@ -43,7 +47,8 @@ class Live:
 
 
 class PlannerWorker:
-    """Owns a `planner.Planner`; driven by commands (run, pause, step, stop) from the UI."""
+    """Owns a planner run (`planner.planner_for`); driven by commands (run, pause, step, stop)
+    from the UI. ``budget`` is the iterations of each tree."""
 
     def __init__(self, problem, options: planner.PlanOptions, budget: int,
                  rate: float | None = None) -> None:
@@ -51,8 +56,12 @@ class PlannerWorker:
         self.budget = budget
         self.rate = rate  # iterations per second, None: as fast as it goes
         self._problem = problem
-        self._run = planner.Planner(problem, options)
-        self._run.add_listener(self._on_events)
+        self._run = planner.planner_for(problem, options)
+        self._optimal = options.timing == "optimal"
+        self._tree = self._run.route if self._optimal else self._run  # the tree drawn
+        self._tree.add_listener(self._on_events)
+        self._stepped = 0  # iterations asked of each tree
+        self._result = self._timed_costs = None  # timing optimal: the result shown, and of what
         self._star = options.planner == "rrtstar"
         self._cmds: queue.Queue[str] = queue.Queue()
         self._stepping = False
@@ -80,7 +89,7 @@ class PlannerWorker:
 
     @property
     def iterations_per_s(self) -> float:
-        return self._run.iterations / self._wall if self._wall > 0 else 0.0
+        return self._tree.iterations / self._wall if self._wall > 0 else 0.0
 
     # -- the thread ------------------------------------------------------------------------------
     def _loop(self) -> None:
@@ -103,7 +112,7 @@ class PlannerWorker:
             self.live.state = "done" if self._done() else ("running" if running else "paused")
             if running:
                 n = batch if self.rate is None else max(1, int(self.rate * BATCH_S))
-                n = min(n, self.budget - self._run.iterations)
+                n = min(n, self.budget - self._stepped)
                 took = self._advance(n)
                 if self.rate is None:
                     batch = max(1, min(20000, int(n * BATCH_S / max(took, 1e-6))))
@@ -115,16 +124,17 @@ class PlannerWorker:
                 time.sleep(0)  # let the UI thread take the GIL between batches
 
     def _done(self) -> bool:
-        return self._run.finished or self._run.iterations >= self.budget
+        return self._run.finished or self._stepped >= self.budget
 
     def _advance(self, n: int, stepping: bool = False) -> float:
         t0 = time.perf_counter()
         self._stepping = stepping
         try:
             self._run.step(n)
+            self._stepped += n
         except Exception as exc:  # noqa: BLE001  (a planner bug must not kill the session)
             self.live.error = f"{type(exc).__name__}: {exc}"
-            self.budget = self._run.iterations
+            self.budget = self._stepped
         took = time.perf_counter() - t0
         self._wall += took
         return took
@@ -138,18 +148,18 @@ class PlannerWorker:
 
     # -- the listener (planner thread) ---------------------------------------------------------
     def _on_events(self, ev: planner.TreeEvents | None) -> None:
-        run, live = self._run, self.live
+        tree, live = self._tree, self.live
         if ev is None:
-            live.chunks.set(0, run.edge_points(0, SEG))
+            live.chunks.set(0, tree.edge_points(0, SEG))
             return
         for node in (*ev.new[ev.new >= 0], *ev.polished):
-            live.chunks.set(int(node), run.edge_points(node, SEG))
+            live.chunks.set(int(node), tree.edge_points(node, SEG))
         now = time.monotonic()
         rewired = []
         for rewire in ev.rewires:
             node = rewire.node
             old = live.chunks.get(node)
-            new = run.edge_points(node, SEG)
+            new = tree.edge_points(node, SEG)
             live.chunks.set(node, new)
             live.flashes.append((now, old, new))
             rewired.append((old, new))
@@ -158,7 +168,7 @@ class PlannerWorker:
         self._note_best(now)
 
     def _note_step(self, ev: planner.TreeEvents, rewired: list) -> None:
-        pose = self._run.poses
+        pose = self._tree.poses
         info = StepInfo.from_events(ev, -1, len(rewired))
         self.live.step = {
             "info": info, "star": self._star, "x_rand": ev.sample[-1].copy(),
@@ -170,27 +180,44 @@ class PlannerWorker:
         self.live.step_version += 1
 
     def _note_best(self, now: float) -> None:
-        run, live = self._run, self.live
-        cost = run.best_cost
+        tree, live = self._tree, self.live
+        cost = tree.best_cost
         if cost is not None and (self._best is None or cost < self._best - 1e-9):
             self._best = cost
-            live.best_path = run.dense_path(0.05)
-            live.best_version += 1
-            live.cost_over_time = run.cost_over_time
+            if not self._optimal:  # else the schedule, timed with the metrics
+                self._show_path(tree.dense_path(0.05))
+            live.cost_over_time = tree.cost_over_time
         if now - self._last_metrics >= 0.5 or self._stepping:
             self._last_metrics = now
             self._publish_metrics()
+
+    def _show_path(self, path: np.ndarray) -> None:
+        self.live.best_path = path
+        self.live.best_version += 1
+
+    def _timed(self) -> planner.Result:
+        """Timing optimal: the run's result, timed anew when a tree's best path has changed
+        (tens of ms: with the metrics, at most twice a second); its path is the one shown."""
+        costs = [p.best_cost for p in self._run.planners]
+        if costs != self._timed_costs:
+            self._timed_costs, self._result = costs, self._run.result()
+            if self._result.solved:
+                self._show_path(self._result.path)
+        return self._result
 
     def _publish_metrics(self) -> None:
         self.live.metrics = self._metrics()
         self.live.metrics_version += 1
 
     def _metrics(self) -> dict:
-        run = self._run
+        tree = self._tree
+        out = {"iterations": tree.iterations, "nodes": tree.nodes, "rewires": tree.rewires,
+               "time_to_first_solution_s": tree.time_to_first_solution_s,
+               "cost": tree.best_cost, "iterations_per_s": self.iterations_per_s}
+        if self._optimal:
+            result = self._timed()
+            return out | {"min_clearance_m": result.min_clearance_m,
+                          "arrival_s": result.cost, "waited_s": result.waited_s}
         if self._clearance_of != self._best:  # the exact check costs ms: at most twice a second
-            self._clearance, self._clearance_of = run.best_path_clearance(), self._best
-        return {"iterations": run.iterations, "nodes": run.nodes,
-                "rewires": run.rewires,
-                "time_to_first_solution_s": run.time_to_first_solution_s,
-                "cost": run.best_cost, "min_clearance_m": self._clearance,
-                "iterations_per_s": self.iterations_per_s}
+            self._clearance, self._clearance_of = tree.best_path_clearance(), self._best
+        return out | {"min_clearance_m": self._clearance}
