@@ -38,6 +38,7 @@ EXTRA_WAIT_S = 60.0  # how long past the top-speed arrival a schedule may wait, 
 MAX_WAIT_S = 600.0  # … and at most, whatever the waypoints' times
 MAX_CELLS = 4_000_000  # s–t grid points; a longer path or horizon gets coarser stations
 FINE_SPACING_M, FINE_STEP_S = 0.005, 0.01  # the clearance metric's sampling
+PROBE_SHARE = 0.2  # of a time budget, for each tree before the leader takes the rest
 
 
 @dataclass(frozen=True)
@@ -158,10 +159,23 @@ class TimeOptimalPlanner:
 
     def advance(self, time_limit: float | None = 1.0, iterations: int | None = None,
                 stop: Callable[[], bool] | None = None) -> None:
-        """Each tree gets the iteration budget, and an equal share of the time."""
-        share = None if time_limit is None else time_limit / len(self.planners)
-        for planner in self.planners:
-            planner.advance(share, iterations, stop)
+        """Each tree gets the iteration budget (so the detour tree is the constant plan's own)
+        and a share of the time: a time-only budget gives each `PROBE_SHARE` of it, then the
+        rest to the tree whose path arrives first by then."""
+        planners = self.planners
+        if iterations is not None or len(planners) == 1:
+            share = None if time_limit is None else time_limit / len(planners)
+            for planner in planners:
+                planner.advance(share, iterations, stop)
+            return
+        for planner in planners:
+            planner.advance(PROBE_SHARE * time_limit, None, stop)
+        arrival = {id(p): math.inf for p in planners}
+        for schedule in self.schedules():
+            key = id(schedule.planner)
+            arrival[key] = min(arrival[key], schedule.arrival_s)
+        leader = min(planners, key=lambda p: arrival[id(p)])
+        leader.advance((1.0 - PROBE_SHARE * len(planners)) * time_limit, None, stop)
 
     def solve(self, time_limit: float | None = 1.0, iterations: int | None = None,
               stop: Callable[[], bool] | None = None) -> Result:
