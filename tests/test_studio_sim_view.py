@@ -3,6 +3,7 @@ its scene clock, the crossing scenario; what `SimView.tick` draws is the frame i
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -57,3 +58,25 @@ def test_the_view_draws_the_frame_it_received(view):
         time.sleep(0.05)
     view.tick()
     assert "stopped" in view.ui.status.content and view.run is None
+
+
+def test_a_collision_and_a_stall_are_marked_where_and_when_with_their_cause(view):
+    """A blind run into the lane's stopped car collides; in the gate scene the car, believing
+    the door shut for good, finds no path and stands: each gets a disc and a label."""
+    for name, kind, cause in (("stop_in_lane", "collision", "clearance"),
+                              ("gate", "stall", "no path found")):
+        settings = dataclasses.replace(view.settings(), realtime=False, duration=12.0,
+                                       replan=name != "stop_in_lane")
+        view.start(planner.compile_problem(planner.load_scenario(name)), settings)
+        run = view.run
+        deadline = time.monotonic() + 60
+        while run.running and time.monotonic() < deadline:
+            time.sleep(0.05)
+        view.tick()
+        events = [e for e in run.events if e[3] == kind]
+        assert events, run.events
+        t, x, y, _, why = events[0]
+        assert cause in why and 0.0 <= t <= 12.0
+        k = run.events.index(events[0])
+        assert np.allclose(view._handles[f"event{k}"].position[:2], (x, y))
+        assert view._handles[f"event{k}/label"].text.startswith(f"{kind} at t = {t:.1f} s")

@@ -50,6 +50,9 @@ PREDICT_S = 2.0  # s of predicted motion drawn ahead of each believed obstacle
 EDGE_PIECES = 4  # straight pieces per drawn tree edge
 GHOST_RGB = (90, 200, 255)
 GHOST_Z = Z["obstacle"] + 0.001
+STALL_S = 2.0  # s standing still (not at the goal) that the scene marks as a stall
+STILL_V = 1e-3  # m/s below which the car stands
+EVENT_RGB = {"collision": (230, 30, 30), "stall": (240, 170, 0)}
 
 
 @dataclass
@@ -111,6 +114,9 @@ class _Run:
         self.tree_version = 0
         self.summary: dict | None = None
         self.error: str | None = None
+        # (t, x, y, kind, cause) of each collision and stall: marked in the scene.
+        self.events: list[tuple[float, float, float, str, str]] = []
+        self._colliding, self._still_since, self._stall_marked = False, None, False
         self._tree_of, self._tree_at = None, -math.inf
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._main, args=(settings,), daemon=True,
@@ -142,6 +148,7 @@ class _Run:
         x, y, theta = f.pose
         self.clearance = self.problem.clearance(x, y, f.t, theta)
         self.min_clearance = min(self.min_clearance, self.clearance)
+        self._note_events(f)
         now = time.monotonic()
         fresh = f.tree is not None and f.tree is not self._tree_of
         if fresh and now - self._tree_at > TREE_S:
@@ -149,6 +156,24 @@ class _Run:
             self.tree = _tree_segments(f.tree)
             self.tree_version += 1
         self.frame = f
+
+
+    def _note_events(self, f: Frame) -> None:
+        """A collision where the clearance turns ≤ 0; a stall once the car has stood `STALL_S`
+        (marked where it began), with its cause: no path yet, or a predicted conflict ahead."""
+        x, y, _ = f.pose
+        if self.clearance <= 0.0 and not self._colliding:
+            self.events.append((f.t, x, y, "collision", f"clearance {self.clearance:.2f} m"))
+        self._colliding = self.clearance <= 0.0
+        if abs(f.v) > STILL_V:
+            self._still_since, self._stall_marked = None, False
+        elif self._still_since is None:
+            self._still_since = f.t
+        elif not self._stall_marked and f.t - self._still_since >= STALL_S:
+            self._stall_marked = True
+            cause = ("no path found" if f.reference is None
+                     else "stopped before a predicted conflict")
+            self.events.append((self._still_since, x, y, "stall", cause))
 
 
 def _tree_segments(tree: planner.TreeSnapshot) -> np.ndarray:
@@ -173,7 +198,8 @@ class SimView:
         self._handles: dict[str, object] = {}
         self._movers = np.zeros(0, np.int64)  # per scenario obstacle: its motion (-1: static)
         self._centres: dict[int, np.ndarray] = {}  # per mover: its declared centre (m)
-        self._shown = {"frame": None, "reference": None, "path_at": 0.0, "tree": 0, "slow": 0.0}
+        self._shown = {"frame": None, "reference": None, "path_at": 0.0, "tree": 0, "slow": 0.0,
+                       "events": 0}
 
     # -- commands ------------------------------------------------------------------------------
     def settings(self) -> SimSettings:
@@ -206,7 +232,7 @@ class SimView:
         for h in self._handles.values():
             h.remove()
         self._handles.clear()
-        self._shown.update(frame=None, reference=None, tree=0)
+        self._shown.update(frame=None, reference=None, tree=0, events=0)
 
     # -- drawing -------------------------------------------------------------------------------
     def _draw_static(self, problem) -> None:
@@ -247,6 +273,7 @@ class SimView:
         if f is not None and f is not self._shown["frame"]:
             self._shown["frame"] = f
             self._draw_frame(f)
+        self._mark_events(run)
         if run.tree_version != self._shown["tree"]:
             self._shown["tree"] = run.tree_version
             self._put("tree", run.tree, TREE_RGB, 1.0)
@@ -257,6 +284,19 @@ class SimView:
             self._status(run, f)
         if finished:
             self.run = None  # finished: the last drawing stays until the next run or scenario
+
+    def _mark_events(self, run: _Run) -> None:
+        """A disc and a label for each new collision or stall: where, when and why."""
+        for k in range(self._shown["events"], len(run.events)):
+            t, x, y, kind, cause = run.events[k]
+            size = marker_size(run.problem.bounds)
+            self._handles[f"event{k}"] = self.scene.add_icosphere(
+                f"/sim/event{k}", radius=2.5 * size, color=EVENT_RGB[kind],
+                position=(x, y, Z["path"]), opacity=0.6)
+            self._handles[f"event{k}/label"] = self.scene.add_label(
+                f"/sim/event{k}/label", f"{kind} at t = {t:.1f} s: {cause}",
+                position=(0.0, 0.0, 0.05), anchor="bottom-left")
+        self._shown["events"] = len(run.events)
 
     def _draw_frame(self, f: Frame) -> None:
         x, y, th = f.pose
