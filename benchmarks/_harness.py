@@ -22,6 +22,19 @@ def write_result(name: str, text: str) -> Path:
     return path
 
 
+def markdown_table(header, rows) -> str:
+    """A Markdown table of ``rows`` (sequences of cells) under ``header``."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    return "\n".join(lines + ["| " + " | ".join(row) + " |" for row in rows])
+
+
+def report(name: str, title: str, header, rows) -> None:
+    """Print the table and write it with its title and command to results/``name``.md."""
+    table = markdown_table(header, rows)
+    print(table)
+    write_result(name, f"{title}\n\nCommand: `python benchmarks/bench_{name}.py`\n\n{table}\n")
+
+
 def run(main: Callable[[], object]) -> None:
     """Run a benchmark's ``main``; Ctrl-C ends it with status 130 and one line."""
     try:

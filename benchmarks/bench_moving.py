@@ -17,6 +17,7 @@ import _harness
 from tqdm import tqdm
 
 import planner
+from planner.rrt import warm_up
 
 SCENES = ["crossing", "gate", "movers"]  # bundled scenarios
 
@@ -42,7 +43,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seeds", type=int, default=10)
     parser.add_argument("--time", type=float, default=1.0)
     args = parser.parse_args(argv)
-    planner.rrt.warm_up()
+    warm_up()
     rows = []
     with tqdm(total=len(SCENES) * args.seeds * 2, unit="run") as bar:
         for name in SCENES:
@@ -63,13 +64,8 @@ def main(argv: list[str] | None = None) -> None:
                     f"{median([r.refused_rewires for r in results]):.0f}"))
     header = ("scene", "obstacles", "solved", "TTFS ms (median)", f"cost @{args.time:g}s",
               "it/s", "rewires", "refused rewires")
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(row) + " |" for row in rows]
-    table = "\n".join(lines)
-    print(table)
     title = f"# Moving obstacles, {args.seeds} seeds, {args.time:g} s budget"
-    _harness.write_result(
-        "moving", f"{title}\n\nCommand: `python benchmarks/bench_moving.py`\n\n{table}\n")
+    _harness.report("moving", title, header, rows)
 
 
 if __name__ == "__main__":

@@ -66,13 +66,8 @@ def main(argv: list[str] | None = None) -> None:
     header = ("scene", "constant solved", "constant arrival s (median)", "optimal solved",
               "optimal arrival s (median)", "optimal earlier / tie / later",
               "constant wall s", "optimal wall s", "optimal worst / best possible")
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(row) + " |" for row in rows]
-    table = "\n".join(lines)
-    print(table)
     title = f"# Timing optimal against constant, {args.seeds} seeds, {args.time:g} s budget"
-    _harness.write_result(
-        "timing", f"{title}\n\nCommand: `python benchmarks/bench_timing.py`\n\n{table}\n")
+    _harness.report("timing", title, header, rows)
 
 
 if __name__ == "__main__":
