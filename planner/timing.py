@@ -30,6 +30,7 @@ from planner._world import inflated, path_clearances, without_movers
 from planner.options import TIMINGS, PlanOptions
 from planner.problem import Problem
 from planner.rrt import Planner, Result
+from planner.scenario import ScenarioError
 
 __all__ = ["TIMINGS", "Schedule", "TimeOptimalPlanner", "fastest_schedule", "planner_for"]
 
@@ -38,6 +39,7 @@ EXTRA_WAIT_S = 60.0  # how long past the top-speed arrival a schedule may wait, 
 MAX_WAIT_S = 600.0  # … and at most, whatever the waypoints' times
 MAX_CELLS = 4_000_000  # s–t grid points; a longer path or horizon gets coarser stations
 FINE_SPACING_M, FINE_STEP_S = 0.005, 0.01  # the clearance metric's sampling
+MAX_ROWS = 200_000  # path entries of a timed path (FORMAT.md spacing): about 10 MB of JSON
 PROBE_SHARE = 0.2  # of a time budget, for each tree before the leader takes the rest
 
 
@@ -58,13 +60,18 @@ class Schedule:
         return 0.0 if self.waits is None else float(self.waits.sum() * self.dt)
 
     @property
+    def spacing_m(self) -> float:
+        """FORMAT.md v1.3's: entries at most 0.05 m apart, and 0.1 s at vmax."""
+        return min(MAX_SPACING_M, MAX_STEP_S * self.vmax)
+
+    @property
     def arrival_s(self) -> float:
         return self.length_m / self.vmax + self.waited_s
 
     def rows(self, spacing: float | None = None, wait_step: float = MAX_STEP_S) -> np.ndarray:
         """The path as rows x, y, θ, κ, direction, t (FORMAT.md v1.3): at most ``spacing`` m
-        (default 0.05 m, and 0.1 s at vmax) and ``wait_step`` s apart."""
-        dense = self.planner.dense_path(spacing or min(MAX_SPACING_M, MAX_STEP_S * self.vmax))
+        (default: FORMAT.md's, `spacing_m`) and ``wait_step`` s apart."""
+        dense = self.planner.dense_path(spacing or self.spacing_m)
         s_rows = dense[:, 5] * self.planner.options.speed  # driven length
         if self.waits is None:
             return _with_times(dense, s_rows / self.vmax)
@@ -204,6 +211,12 @@ class TimeOptimalPlanner:
                 time_to_first_solution_s=first, timed=True, objective="time", length_m=None,
                 options=self.options)
         best = min(candidates, key=lambda c: c.arrival_s)
+        entries = best.length_m / best.spacing_m + best.waited_s / MAX_STEP_S
+        if entries > MAX_ROWS:
+            raise ScenarioError(
+                f"vehicle.max_speed: {best.vmax:g} m/s over {best.length_m:.1f} m needs about "
+                f"{entries:.3g} path entries at most 0.05 m and 0.1 s apart, more than "
+                f"{MAX_ROWS}: give a higher max_speed, or plan with timing constant")
         path, fine = best.rows(), best.rows(FINE_SPACING_M, FINE_STEP_S)
         return dataclasses.replace(
             results[self.planners.index(best.planner)], **totals, cost=float(path[-1, 5]),

@@ -8,6 +8,7 @@ import math
 import subprocess
 
 import numpy as np
+import pytest
 from checker import arc_mismatch, first_collision, schedule_errors
 from conftest import scenario_dict
 from hypothesis import given, settings
@@ -92,3 +93,11 @@ def test_optimal_plans_are_valid_and_never_later_than_constant(movers, seed):
         assert optimal.solved and optimal.cost <= constant.arrival_time_s + 1e-9
     if optimal.solved:
         assert_valid_v13(scn, optimal.path[:, [0, 1, 2, 5]])
+
+
+def test_a_crawl_that_needs_too_many_entries_is_refused_naming_max_speed():
+    scn = scenario_dict("slalom")
+    scn["vehicle"].update(speed=0.001, max_speed=0.001)  # 0.1 mm apart over 23 m
+    with pytest.raises(planner.ScenarioError, match="vehicle.max_speed: 0.001 m/s"):
+        planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=300,
+                      timing="optimal")
