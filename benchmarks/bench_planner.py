@@ -39,12 +39,15 @@ LONG_SEEDS = [0, 1, 2]
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenarios", nargs="+", default=STATIC_SCENARIOS, metavar="NAME",
-                        help="bundled scenario names (crossing has a moving obstacle OMPL "
+                        help="bundled scenario names or scenario files, e.g. "
+                             "benchmarks/scenes/*.json (crossing has a moving obstacle OMPL "
                              "cannot express)")
     parser.add_argument("--seeds", nargs="+", type=int, default=list(range(5)))
     parser.add_argument("--budgets", nargs="+", type=float, default=[0.1, 1.0], metavar="SECONDS")
     parser.add_argument("--only", choices=[OURS, "ompl"], help="run only our planner or only OMPL")
     parser.add_argument("--json", type=Path, metavar="OUT", help="also write every run's record")
+    parser.add_argument("--out", default="planner", metavar="NAME",
+                        help="write the tables to benchmarks/results/NAME.md")
     parser.add_argument("--long-s", type=float, default=20.0, metavar="SECONDS",
                         help="budget of the long runs that find a missing best known cost")
     args = parser.parse_args(argv)
@@ -284,8 +287,11 @@ def main(argv: list[str] | None = None) -> None:
     args = parse_args(argv)
     import planner
 
-    paths = {name: planner.bundled_scenario_path(name) for name in args.scenarios}
-    scenarios = {name: json.loads(path.read_text()) for name, path in paths.items()}
+    files = [Path(a) if Path(a).is_file() else planner.bundled_scenario_path(a)
+             for a in args.scenarios]
+    scenarios = {(data := json.loads(f.read_text()))["name"]: data for f in files}
+    paths = dict(zip(scenarios, files))
+    args.scenarios = list(scenarios)
     runs_per_planner = len(paths) * len(args.seeds)
     n_ompl = 0 if args.only == OURS else runs_per_planner * len(OMPL_PLANNERS) * len(args.budgets)
     n_ours = 0 if args.only == "ompl" else runs_per_planner
@@ -306,7 +312,7 @@ def main(argv: list[str] | None = None) -> None:
                   known)
 
     print(text)
-    _harness.write_result("planner", text)
+    _harness.write_result(args.out, text)
     if args.json:
         args.json.write_text(json.dumps(records, indent=1))
 
