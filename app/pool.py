@@ -22,7 +22,7 @@ PARENT_POLL_S = 0.5
 
 
 def _worker_start(parent: int) -> None:
-    from planner.rrt import warm_up  # here: importing the pool loads no kernels
+    from planner.timing import warm_up  # here: importing the pool loads no kernels
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     threading.Thread(target=_exit_with_parent, args=(parent,), daemon=True,

@@ -32,7 +32,8 @@ from planner.problem import Problem
 from planner.rrt import Planner, Result
 from planner.scenario import ScenarioError
 
-__all__ = ["TIMINGS", "Schedule", "TimeOptimalPlanner", "fastest_schedule", "planner_for"]
+__all__ = ["TIMINGS", "Schedule", "TimeOptimalPlanner", "fastest_schedule", "planner_for",
+           "warm_up"]
 
 MAX_SPACING_M, MAX_STEP_S = 0.05, 0.1  # FORMAT.md v1.3: entries at most this far apart
 EXTRA_WAIT_S = 60.0  # how long past the top-speed arrival a schedule may wait, at least
@@ -234,3 +235,23 @@ def planner_for(problem: Problem, options: PlanOptions | None = None):
     if options.timing == "optimal":
         return TimeOptimalPlanner(problem, options)
     return Planner(problem, options)
+
+
+_warm = False
+
+
+def warm_up() -> None:
+    """Compile (or load from numba's cache) every planning kernel once, the schedule's with
+    the trees' (`planner.rrt.warm_up`), outside any timed budget."""
+    global _warm
+    if _warm:
+        return
+    from planner._world import build_world
+    from planner.rrt import warm_up as warm_up_trees
+
+    warm_up_trees()
+    world = build_world((0, 0, 10, 10), 0.1, [(5, 5, 1, 0)], [], [("velocity", (0.0, 0.5))])
+    problem = Problem(None, world, (0.5, 5.0, 0.0), (9.5, 5.0, 0.0), 0.5, 0.5, 1.0, 1.0, True,
+                      max_speed=2.0)
+    TimeOptimalPlanner(problem, PlanOptions(timing="optimal")).solve(None, 200)
+    _warm = True

@@ -44,6 +44,6 @@ def scenario_dict(name: str) -> dict:
 def compiled_planner():
     """Compile the planner's kernels once, in this process, into numba's on-disk cache, so the
     CLI subprocesses the tests start load them in about a second."""
-    from planner.rrt import warm_up
+    from planner.timing import warm_up
 
     warm_up()

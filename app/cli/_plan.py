@@ -46,7 +46,7 @@ def plan(
         if animate is not None:
             check_animation_path(animate)
         scenario_model = core.load_scenario(scenario)
-        warm_kernels()
+        warm_kernels(options.timing)
         recorder = FrameRecorder()
         report = run_plan(scenario_model, options, observe=recorder if animate else None,
                           chunks=FRAMES if animate else 1)

@@ -64,7 +64,7 @@ def simulate(
         for name, out in (("--log", log), ("--raceline", raceline)):
             if out is not None and not out.parent.is_dir():
                 raise ValueError(f"{name}: directory {str(out.parent)!r} does not exist")
-        warm_kernels()
+        warm_kernels(timing)
         result = run_simulation(problem.scenario, settings, problem, behaviour=machine)
         if log is not None:
             result.write_log(log)

@@ -36,7 +36,7 @@ def launch(host: str, port: int, api_url: str, access: Access | None = None) -> 
     browsers may connect (default: loopback names and ``host``, no token)."""
     from app.studio._gate import Gate
     from app.studio._session import Session
-    from planner.rrt import warm_up
+    from planner.timing import warm_up
 
     warm_up()  # compiled kernels from numba's cache, before the first tab waits for them
     server = viser.ViserServer(host=host, port=port, verbose=False)

@@ -30,6 +30,7 @@ from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
 from planner.sim.sensing import Sensing, mover_index, sense, true_offsets
 from planner.sim.vehicle import Limits, arc_step, limit_commands
+from planner.timing import warm_up as warm_up_timing
 from planner.tree import TreeSnapshot
 
 __all__ = ["Frame", "SimRun", "SimSettings", "simulate"]
@@ -145,6 +146,8 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     counter = _lap_counter(scenario, problem, s, load_track)  # before the slow warm-up
     warm_up()
     warm_up_replanning()
+    if s.timing == "optimal":
+        warm_up_timing()
     vehicle = scenario.vehicle
     limits = Limits.of(vehicle)
     dt = 1.0 / s.control_rate
