@@ -47,9 +47,10 @@ LANE_SHARE, LANE_SIGMA = 0.9, 0.25  # track scenarios: headings sampled along th
 NEAREST_BUCKETS = 256  # nearest's queue: half-cell buckets, the last one takes the rest
 # Counter indices; POLISH_AT: the iteration at which the best path is next polished.
 N, NGOAL, ITER, CHECKS, BEST, REWIRES, EVALS, IMPROVED, REFUSED, POLISH_AT, NCOUNTERS = range(11)
-# Event row columns (only written when the event buffers are non-empty).
+# Event row columns (only written when the event buffers are non-empty); EV_XN..EV_THN: where
+# Steer ended, x_new whether the motion to it was free or not.
 EV_ITER, EV_XR, EV_YR, EV_THR, EV_NEAREST, EV_NEW, EV_PARENT, EV_NEAR_START, EV_NEAR_END, \
-    EV_RADIUS, EV_BEST, EV_COLS = range(12)
+    EV_RADIUS, EV_BEST, EV_XN, EV_YN, EV_THN, EV_COLS = range(15)
 
 
 class Tree(NamedTuple):
@@ -620,6 +621,9 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
         th = wrap_angle(th)
         if record:
             ev.rows[row, EV_NEAREST] = near_i
+            ev.rows[row, EV_XN] = x
+            ev.rows[row, EV_YN] = y
+            ev.rows[row, EV_THN] = th
         if dist <= 0.0:
             continue
         tree.cnt[CHECKS] += 1

@@ -18,11 +18,12 @@ from planner import _kernel as K
 from planner._paths import TURN, advance, pose_at, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
+from planner._steer import steer_path
 from planner._world import inflated, path_clearances
 from planner.options import METRICS, PLANNERS, PlanOptions
 from planner.problem import Problem, check_room
 from planner.steering import STEERINGS
-from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points
+from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points, path_points
 
 __all__ = ["Planner", "Result", "warm_up"]
 
@@ -163,11 +164,25 @@ class Planner:
         view.flags.writeable = False
         return view
 
+    @property
+    def costs(self) -> np.ndarray:
+        """A read-only *live* view of the nodes' costs from the root, like `poses`."""
+        view = self._tree.cost[: self.nodes]
+        view.flags.writeable = False
+        return view
+
     def edge_points(self, node: int, count: int = 4) -> np.ndarray:
         """(count + 1, 2) positions along the local path from ``node``'s parent to it (the root:
         its position repeated), for drawing curved edges; live, like `poses`."""
         t = self._tree
         return edge_points(t.pose, t.parent, t.kinds, t.lens, self.problem.rho, node, count)
+
+    def steer_points(self, a, b, count: int = 4) -> np.ndarray:
+        """(count + 1, 2) positions along this planner's steering from pose a to pose b: a
+        motion the tree does not hold, such as a Steer that an obstacle blocked."""
+        kinds, lens = np.zeros(5, np.int8), np.zeros(5)
+        steer_path(STEERINGS[self.options.steering].code, *a, *b, self.problem.rho, kinds, lens)
+        return path_points(a, kinds, lens, self.problem.rho, count)
 
     @property
     def finished(self) -> bool:
@@ -374,6 +389,8 @@ def _named(ev: K.Events) -> TreeEvents:
         iteration=ints(K.EV_ITER), sample=rows[:, [K.EV_XR, K.EV_YR, K.EV_THR]],
         nearest=ints(K.EV_NEAREST), new=ints(K.EV_NEW), parent=ints(K.EV_PARENT),
         radius=rows[:, K.EV_RADIUS].copy(), best_cost=rows[:, K.EV_BEST].copy(),
+        steered=np.where(rows[:, [K.EV_NEAREST]] >= 0, rows[:, [K.EV_XN, K.EV_YN, K.EV_THN]],
+                         np.nan),
         rewires=[Rewire(*map(int, r)) for r in ev.rewires[:n_rw]],
         polished=ev.polished[:n_polished].copy(),
         _near=ev.near[:n_near].copy(), _near_span=ints([K.EV_NEAR_START, K.EV_NEAR_END]))

@@ -14,7 +14,7 @@ import numpy as np
 
 from planner._paths import path_length, sample_path
 
-__all__ = ["Rewire", "TreeEvents", "TreeSnapshot", "edge_points"]
+__all__ = ["Rewire", "TreeEvents", "TreeSnapshot", "edge_points", "path_points"]
 
 
 def edge_points(pose, parent, kinds, lens, rho: float, node: int, count: int) -> np.ndarray:
@@ -23,8 +23,13 @@ def edge_points(pose, parent, kinds, lens, rho: float, node: int, count: int) ->
     up = int(parent[node])
     if up < 0:
         return np.repeat(pose[node:node + 1, :2], count + 1, axis=0)
-    total = path_length(kinds[node], lens[node])
-    dense = sample_path(*pose[up], kinds[node], lens[node], rho, max(total / (4 * count), 1e-6))
+    return path_points(pose[up], kinds[node], lens[node], rho, count)
+
+
+def path_points(start, kinds, lens, rho: float, count: int) -> np.ndarray:
+    """(count + 1, 2) positions, evenly spread, along a local path from pose ``start``."""
+    total = path_length(kinds, lens)
+    dense = sample_path(*start, kinds, lens, rho, max(total / (4 * count), 1e-6))
     pick = np.linspace(0, len(dense) - 1, count + 1).round().astype(int)
     return dense[pick, :2]
 
@@ -73,6 +78,7 @@ class TreeEvents:
     new: np.ndarray  # (n,) int: x_new, the node added
     parent: np.ndarray  # (n,) int: x_new's parent (x_min for RRT*)
     radius: np.ndarray  # (n,): the near radius r(n) (0 for RRT, inf for k-nearest)
+    steered: np.ndarray  # (n, 3): where Steer ended, x_new added or blocked (NaN: no Steer)
     best_cost: np.ndarray  # (n,): the best cost after the iteration (inf: none yet)
     rewires: list[Rewire]
     polished: np.ndarray  # nodes added as the polished best path (`planner._polish`), in order
