@@ -378,11 +378,45 @@ def test_a_negative_budget_is_refused_with_the_models_message():
 def test_step_labels_never_share_a_place():
     from app.studio._live_view import step_labels
 
+    bounds = (-10.0, -10.0, 10.0, 10.0)  # markers of 0.12
     rand, nearest = np.array([1.0, 1.0, 0.0]), np.array([0.0, 0.0, 0.0])
-    reached = step_labels({"x_rand": rand, "nearest": nearest, "new": rand.copy()}, 0.1)
-    assert [text for _, text, _, _ in reached] == ["x_new = x_rand", "x_nearest"]
-    short = step_labels({"x_rand": rand, "nearest": nearest, "new": rand * 0.98}, 0.1)
-    assert {text: anchor for _, text, _, anchor in short} == {
-        "x_rand": "bottom-left", "x_nearest": "bottom-left", "x_new": "top-left"}
-    blocked = step_labels({"x_rand": nearest + 0.05, "nearest": nearest, "new": None}, 0.1)
-    assert [anchor for _, _, _, anchor in blocked] == ["top-left", "bottom-left"]
+
+    def labels(new, blocked=None, rand=rand):
+        st = {"x_rand": rand, "nearest": nearest, "new": new, "blocked": blocked,
+              "rewired": []}
+        return {text: (where, anchor) for _, text, where, anchor in step_labels(st, bounds)}
+
+    assert list(labels(rand.copy())) == ["x_new = x_rand", "x_nearest"]
+    short = labels(rand * 0.98)  # x_new just short of x_rand: their labels go opposite ways
+    assert short["x_new"][1] != short["x_rand"][1] and short["x_nearest"][1] == "top-right"
+    across = labels(np.array([0.3, 0.0, 0.0]), rand=np.array([2.0, 0.0, 0.0]))
+    (x_new, _), (x_nearest, _) = across["x_new"], across["x_nearest"]
+    assert x_nearest[0] < 0 < x_new[0]  # on a line: x_nearest's label left, x_new's right
+    blocked = labels(None, (np.array([0.3, 0.1, 0.0]), None), rand=np.array([2.0, 0.0, 0.0]))
+    assert set(blocked) == {"x_new (blocked)", "x_rand", "x_nearest"}
+
+
+def test_step_until_a_rewire_stops_at_one_and_states_the_near_radius_it_used():
+    """`Step until a rewire` runs single iterations to the first that rewired, shows each
+    rewired node's cost before and after, and r(n)'s formula with its numbers gives the radius
+    the kernel used (γ = 2: its term, not ε, bounds r)."""
+    from app.studio._extend import near_note
+    from app.studio._worker import PlannerWorker
+
+    worker = PlannerWorker(_problem(), planner.PlanOptions(seed=0, gamma=2.0), budget=5000)
+    try:
+        worker.step("rewire")
+        deadline = time.monotonic() + 10
+        while worker.live.step is None and time.monotonic() < deadline:
+            time.sleep(0.01)
+        step, nodes = worker.live.step, worker._run.nodes
+    finally:
+        worker.stop()
+    info = step["info"]
+    assert step["until"] == ("rewire", info.iteration, "found") and info.n_rewired > 0
+    assert info.new == nodes - 1 and all(now < was for *_, was, now in step["rewired"])
+    note = near_note(info, step["options"])
+    term = 2.0 * (math.log(nodes) / nodes) ** (1 / 3)
+    assert term < step["options"].eps and info.radius == pytest.approx(term)
+    assert note.endswith(f"= min({term:.2f}, {step['options'].eps:.2f}) = {info.radius:.2f} m "
+                         f"(n = {nodes} nodes, d = 3: x, y, θ).")

@@ -7,11 +7,12 @@ the planner really did (rejected sample, blocked steer, new node, rewires), not 
 from __future__ import annotations
 
 import html
+import math
 from dataclasses import dataclass
 
 import planner
 
-__all__ = ["FIRST_NOTE", "LINES", "StepInfo", "explain", "render"]
+__all__ = ["FIRST_NOTE", "LINES", "StepInfo", "explain", "near_note", "render", "until_note"]
 
 LINES = (
     "x_rand ← SampleFree()",
@@ -61,11 +62,44 @@ def explain(info: StepInfo, star: bool) -> tuple[int, str]:
                f"{info.n_near} near nodes (r = {info.radius:.2f} m); none got cheaper.")
 
 
-def render(line: int | None, note: str) -> str:
-    """The panel's HTML: numbered pseudocode, the current line in a <mark>, the note below."""
+def near_note(info: StepInfo, options) -> str:
+    """The near set's size rule with this iteration's numbers filled in, so that the shrinking
+    ball of RRT* — and whether γ's term or ε bounds it — can be read off; "" when the
+    iteration formed no near set (no node added, or RRT). ``options``: the run's resolved
+    `PlanOptions`."""
+    if info.new < 0 or options.planner != "rrtstar":
+        return ""
+    n = info.new + 1  # the tree's size with x_new, as the kernel counts it
+    if options.k_rrt:
+        return (f"Near set: the k(n) = ⌈k·log n⌉ = ⌈{options.k_rrt:g}·log {n}⌉ = "
+                f"{math.ceil(options.k_rrt * math.log(n))} nearest nodes.")
+    g, d, eps = options.gamma, options.dimensions, options.eps
+    term = g * (math.log(n) / n) ** (1 / d)
+    return (f"Near radius r(n) = min(γ·(log n / n)^(1/d), ε) = min({g:.2f}·(log {n} / {n})"
+            f"^(1/{d}), {eps:.2f}) = min({term:.2f}, {eps:.2f}) = {min(term, eps):.2f} m "
+            f"(n = {n} nodes, d = {d}: x, y{', θ' if d == 3 else ''}).")
+
+
+def until_note(until: str | None, count: int, outcome: str) -> str:
+    """What a "step until" did (`PlannerWorker.step`): ``outcome`` "found", "done" (the run
+    ended first) or "cap" (it gave up)."""
+    if until is None:
+        return ""
+    if outcome == "found":
+        event = "a node was added" if until == "node" else "a rewire"
+        return f"Stepped {count} iteration{'s' * (count > 1)} until {event}."
+    why = "the run is done" if outcome == "done" else "the most one press steps"
+    return (f"{count:,} iterations without {'a new node' if until == 'node' else 'a rewire'}: "
+            f"stopped ({why}).")
+
+
+def render(line: int | None, *notes: str) -> str:
+    """The panel's HTML: numbered pseudocode, the current line in a <mark>, the notes below
+    (empty ones left out)."""
     rows = []
     for i, text in enumerate(LINES):
         code = f"{i + 1:>2}  {html.escape(text)}"
         rows.append(f"<mark>{code}</mark>" if i == line else code)
     return ("<pre style='font-size:11px;line-height:1.5;margin:0;white-space:pre-wrap'>"
-            + "\n".join(rows) + f"</pre><p style='font-size:12px'>{html.escape(note)}</p>")
+            + "\n".join(rows) + "</pre>"
+            + "".join(f"<p style='font-size:12px'>{html.escape(n)}</p>" for n in notes if n))

@@ -1,30 +1,93 @@
 """Drawing a planner's `Live` record into one client's scene, at UI rate.
 
 `LiveView.tick` is called ~20 times a second: tail chunks every tick, rewired chunks a few per
-slow tick, fading rewire flashes, the best path when it improves, the step-mode overlay.
+slow tick, fading rewire flashes, the best path when it improves, the step-mode overlay. Every
+colour it draws is named in `LEGEND`, which the panel shows.
 """
 
 from __future__ import annotations
 
+import html
 import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
-from app.studio._scene import Z, polyline_segments
+from app.studio._scene import (
+    CURVATURE_RGB,
+    GOAL_RGB,
+    MOVER_RGB,
+    OBSTACLE_RGB,
+    START_RGB,
+    Z,
+    marker_size,
+    metres_per_px,
+    polyline_segments,
+)
 from app.studio._worker import FLASH_S, Live
 
-__all__ = ["LiveView", "step_labels"]
+__all__ = ["LEGEND", "LiveView", "Look", "legend_html", "place_labels", "step_labels"]
 
 TREE_RGB = (70, 150, 235)
+TREE_FADED_RGB = (90, 98, 118)  # near the asphalt: the path and the step overlay stand out
 PATH_RGB = (255, 90, 200)
-OLD_RGB, NEW_RGB = (255, 60, 60), (80, 255, 120)
+RAND_RGB, NEAREST_RGB, NEW_RGB, NEAR_RGB = (255, 255, 255), (90, 170, 255), (80, 255, 120), (
+    250, 220, 90)
+REWIRE_OLD_RGB, REWIRE_NEW_RGB = (255, 160, 60), (80, 255, 220)
+BLOCKED_RGB = (255, 40, 40)
+LEGEND = (  # (what, colour or colours, drawn as a line, a ring or a filled shape)
+    ("tree", TREE_RGB, "line"), ("best path", PATH_RGB, "line"),
+    ("x_rand, the sample", RAND_RGB, "ring"), ("x_nearest", NEAREST_RGB, "ring"),
+    ("x_new, its edge from x_min", NEW_RGB, "ring"), ("near set, radius r(n)", NEAR_RGB, "ring"),
+    ("rewire: old edge", REWIRE_OLD_RGB, "line"), ("rewire: new edge", REWIRE_NEW_RGB, "line"),
+    ("blocked Steer", BLOCKED_RGB, "line"), ("start", START_RGB, "fill"),
+    ("goal", GOAL_RGB, "fill"), ("obstacle", OBSTACLE_RGB, "fill"),
+    ("moving obstacle", MOVER_RGB, "fill"),
+    ("centreline: straight … tightest turn", CURVATURE_RGB, "line"),
+)
+TREE_PX = 1.2
+SIDES = ((1, 1), (1, -1), (-1, 1), (-1, -1))  # a label's quadrant off its point (x, y)
+# A label's size on screen at scale 1 (viser: a 12 px em, padded): px per character, padding
+# and height.
+LABEL_CHAR_PX, LABEL_PAD_PX, LABEL_H_PX = 6.5, 8.0, 18.0
+MARKER_PX = 6.0  # a marker's size in the fitted view: the scale when the camera is not known
 REWIRED_PER_SLOW_TICK = 4
 SLOW_EVERY = 5  # ticks
 # Rewire flashes (up to 96 edges, 0.6 s each) change every tick while RRT* rewires: re-sent every
 # other tick with every other point of the edge, a quarter of the bytes of a full redraw.
 FLASH_EVERY = 2  # ticks
 FLASH_STRIDE = 2
+
+
+@dataclass(frozen=True)
+class Look:
+    """How a run is drawn: ``scale`` multiplies line widths and label sizes (projector mode);
+    ``faded`` draws the tree in a colour near the asphalt's."""
+
+    scale: float = 1.0
+    faded: bool = False
+
+    @property
+    def tree_rgb(self) -> tuple[int, int, int]:
+        return TREE_FADED_RGB if self.faded else TREE_RGB
+
+
+def legend_html() -> str:
+    """`LEGEND` as a two-column grid of swatches, for the panel."""
+    def swatch(rgb, kind: str) -> str:
+        paint = (f"linear-gradient(90deg,{','.join(f'rgb{c}' for c in rgb)})"
+                 if isinstance(rgb[0], tuple) else f"rgb{rgb}")
+        shape = {"line": "width:18px;height:4px",
+                 "ring": f"width:9px;height:9px;border-radius:50%;border:3px solid rgb{rgb}",
+                 "fill": "width:12px;height:10px"}[kind]
+        fill = "" if kind == "ring" else f";background:{paint}"
+        return (f"<span style='display:inline-block;{shape}{fill};outline:1px solid #999;"
+                f"margin-right:5px;vertical-align:middle'></span>")
+    cells = "".join(f"<div>{swatch(rgb, kind)}{html.escape(what)}</div>"
+                    for what, rgb, kind in LEGEND)
+    return ("<div style='font-size:12px;display:grid;grid-template-columns:1fr 1fr;"
+            f"gap:3px 8px;margin-top:6px'>{cells}</div>")
 
 
 def _circle(x: float, y: float, r: float, z: float, n: int = 40) -> np.ndarray:
@@ -38,48 +101,101 @@ def _edges(pts_list: list[np.ndarray], z: float) -> np.ndarray:
     return np.concatenate([polyline_segments(p, z) for p in pts_list])
 
 
-def step_labels(st: dict, marker: float) -> list[tuple[str, str, tuple[float, float], str]]:
-    """(node, text, position, anchor) of the step's labels, right of their points: x_nearest
-    above, x_new below, x_rand above when x_new is elsewhere (then it is ε from x_nearest) and
-    below when not, so that close points keep their labels apart. A Steer that reached the
-    sample puts x_new on x_rand: one label names both."""
-    def at(pose, above: bool) -> tuple[tuple[float, float], str]:
-        dy = marker if above else -marker
-        return (float(pose[0]) + marker, float(pose[1]) + dy), ("bottom-left" if above
-                                                               else "top-left")
+def _label_box(p: np.ndarray, side, size: np.ndarray, marker: float):
+    """(low corner, high corner) of a label of ``size`` a marker off point p toward ``side``."""
+    corner = p + marker * np.asarray(side)
+    far = corner + size * side
+    return np.minimum(corner, far), np.maximum(corner, far)
 
-    rand, new = st["x_rand"], st["new"]
-    same = new is not None and math.dist(rand[:2], new[:2]) < 0.1 * marker
-    elsewhere = new is not None and not same
-    out = [("step_rand_l", "x_new = x_rand" if same else "x_rand", *at(rand, elsewhere))]
-    if st["nearest"] is not None:
-        out.append(("step_nearest_l", "x_nearest", *at(st["nearest"], True)))
-    if elsewhere:
-        out.append(("step_new_l", "x_new", *at(new, False)))
+
+def _clashes(box, placed: list, points: list, marker: float, bounds) -> int:
+    """How badly ``box`` sits: leaving the scene's ``bounds`` counts 4, each ``placed`` box it
+    overlaps 2, each point's marker it covers 1."""
+    lo, hi = box
+    return (4 * int(np.any(lo < bounds[:2]) or np.any(hi > bounds[2:]))
+            + 2 * sum(bool(np.all(lo < c[1]) and np.all(c[0] < hi)) for c in placed)
+            + sum(bool(np.all(lo - marker < q) and np.all(q < hi + marker)) for q in points))
+
+
+def place_labels(points: list[tuple[str, str, np.ndarray]], bounds, scale: float = 1.0,
+                 m_per_px: float | None = None
+                 ) -> list[tuple[str, str, tuple[float, float], str]]:
+    """(node, text, position, anchor) for labels of (node, text, point), placed in the order
+    given: each sits diagonally off its point, on the side where its box clashes least
+    (`_clashes`) with the scene's ``bounds`` (xmin, ymin, xmax, ymax), the labels placed
+    before it and the other points; of equal sides, the one away from the other points.
+    Labels keep their size on screen: ``m_per_px`` (the view's, when it is known) gives their
+    size on the ground. Points that look the same get one label naming both."""
+    marker, bounds = marker_size(bounds), np.asarray(bounds, float)
+    px = (m_per_px or marker / MARKER_PX) * scale
+    merged: list[list] = []
+    for node, text, p in points:
+        twin = next((m for m in merged if math.dist(m[2], p[:2]) < 0.1 * marker), None)
+        if twin is None:
+            merged.append([node, text, np.asarray(p[:2], float)])
+        else:
+            twin[1] += f" = {text}"
+    placed, out = [], []
+    for node, text, p in merged:
+        others = [q for _, _, q in merged if q is not p]
+        away = sum(((p - q) / max(float(np.dot(p - q, p - q)), 1e-12) for q in others),
+                   np.zeros(2))  # the nearest point pushes hardest
+        size = np.array([LABEL_CHAR_PX * len(text) + LABEL_PAD_PX, LABEL_H_PX]) * px
+        boxes = {side: _label_box(p, side, size, marker) for side in SIDES}
+        side = min(SIDES, key=lambda sd: (_clashes(boxes[sd], placed, others, marker, bounds),
+                                          -float(np.dot(sd, away))))
+        placed.append(boxes[side])
+        anchor = f"{'bottom' if side[1] > 0 else 'top'}-{'left' if side[0] > 0 else 'right'}"
+        out.append((node, text, tuple(float(v) for v in p + marker * np.asarray(side)), anchor))
     return out
+
+
+def step_labels(st: dict, bounds, scale: float = 1.0, m_per_px: float | None = None
+                ) -> list[tuple[str, str, tuple[float, float], str]]:
+    """The step overlay's labels (see `place_labels`): x_rand, x_nearest, x_new (blocked or
+    added) and, for each rewired node, the cost of reaching it by the old and the new edge,
+    at the middle of each."""
+    points = [("step_rand_l", "x_rand", st["x_rand"])]
+    if st["nearest"] is not None:
+        points.append(("step_nearest_l", "x_nearest", st["nearest"]))
+    if st["new"] is not None:
+        points.insert(0, ("step_new_l", "x_new", st["new"]))
+    elif st["blocked"] is not None:
+        points.insert(0, ("step_new_l", "x_new (blocked)", st["blocked"][0]))
+    for i, (old, new, was, now) in enumerate(st["rewired"]):
+        points += [(f"step_was{i}_l", f"old {was:.2f} m", old[len(old) // 2]),
+                   (f"step_now{i}_l", f"new {now:.2f} m", new[len(new) // 2])]
+    return place_labels(points, bounds, scale, m_per_px)
 
 
 class LiveView:
     """One run's drawing in one client's scene; `clear` removes all of it."""
 
-    def __init__(self, scene, live: Live, marker: float) -> None:
-        self.scene, self.live, self.marker = scene, live, marker
+    def __init__(self, scene, live: Live, bounds, look: Look = Look(), camera=None) -> None:
+        """``bounds``: the scene's (xmin, ymin, xmax, ymax), which sizes the markers;
+        ``camera``: the client's, whose view sizes the step labels."""
+        self.scene, self.live, self.bounds, self.look = scene, live, bounds, look
+        self.camera = camera
+        self.marker = marker_size(bounds)
         self._chunks: dict[int, object] = {}
         self._handles: dict[str, object] = {}
+        self._px: dict[str, float] = {}  # each line node's width at scale 1
         self._seen = {"best": 0, "step": 0}
         self._ticks = 0
         self.sent_chunks = 0
 
     def _put(self, name: str, seg: np.ndarray, rgb, px: float, z: float | None = None):
-        """Create or update a line-segments node (hidden when empty)."""
+        """Create or update a line-segments node (hidden when empty); ``px`` at scale 1."""
         h = self._handles.get(name)
         if len(seg) == 0:
             if h is not None:
                 h.visible = False
             return
         if h is None:
+            self._px[name] = px
             self._handles[name] = self.scene.add_line_segments(
-                f"/live/{name}", seg, rgb, thickness=px, thickness_units="screen")
+                f"/live/{name}", seg, rgb, thickness=px * self.look.scale,
+                thickness_units="screen")
         else:
             h.points = seg
             h.visible = True
@@ -95,7 +211,8 @@ class LiveView:
             h = self._chunks.get(c)
             if h is None:
                 self._chunks[c] = self.scene.add_line_segments(
-                    f"/live/tree/c{c}", seg, TREE_RGB, thickness=1.2, thickness_units="screen")
+                    f"/live/tree/c{c}", seg, self.look.tree_rgb,
+                    thickness=TREE_PX * self.look.scale, thickness_units="screen")
             else:
                 h.points = seg
             self.sent_chunks += 1
@@ -114,38 +231,51 @@ class LiveView:
         fl = [f for f in list(self.live.flashes) if now - f[0] < FLASH_S]
         if not fl and "flash_old" not in self._handles:
             return
-        self._put("flash_old", _edges([f[1][::FLASH_STRIDE] for f in fl], Z["flash"]), OLD_RGB, 2.5)
-        self._put("flash_new", _edges([f[2][::FLASH_STRIDE] for f in fl], Z["flash"]), NEW_RGB, 2.5)
+        self._put("flash_old", _edges([f[1][::FLASH_STRIDE] for f in fl], Z["flash"]),
+                  REWIRE_OLD_RGB, 2.5)
+        self._put("flash_new", _edges([f[2][::FLASH_STRIDE] for f in fl], Z["flash"]),
+                  REWIRE_NEW_RGB, 2.5)
 
     def _step_overlay(self, st: dict | None) -> None:
-        """x_rand, x_nearest, x_new, the near radius and nodes, the chosen parent edge."""
+        """x_rand, x_nearest, x_new (or where a blocked Steer ended, and its motion), the near
+        radius and nodes, the chosen parent edge, the rewired edges old and new; labelled."""
         for name in [n for n in self._handles if n.startswith("step_")]:
             self._handles[name].visible = False
         if st is None:
             return
         m, z = self.marker, Z["step"]
         xr = st["x_rand"]
-        self._put("step_rand", _circle(xr[0], xr[1], m, z, 12), (255, 255, 255), 3.0)
+        self._put("step_rand", _circle(xr[0], xr[1], m, z, 12), RAND_RGB, 3.0)
         if st["nearest"] is not None:
-            self._put("step_nearest", _circle(*st["nearest"][:2], m, z, 12), (90, 170, 255), 3.0)
-        for label in step_labels(st, m):
-            self._label(*label)
+            self._put("step_nearest", _circle(*st["nearest"][:2], m, z, 12), NEAREST_RGB, 3.0)
+        if st["blocked"] is not None:
+            end, pts = st["blocked"]
+            # A dark line under the red one keeps it visible across a red obstacle.
+            self._put("step_blocked_under", _edges([pts], z - 1e-4), (30, 30, 30), 7.0)
+            self._put("step_blocked", _edges([pts], z), BLOCKED_RGB, 3.5)
+            self._put("step_blocked_end", _circle(end[0], end[1], m, z, 12), BLOCKED_RGB, 3.0)
         if st["new"] is not None:
             nx, ny = st["new"][:2]
             self._put("step_new", _circle(nx, ny, m, z, 12), NEW_RGB, 3.0)
             if st["radius"] > 0 and math.isfinite(st["radius"]):
-                self._put("step_radius", _circle(nx, ny, st["radius"], z, 64), (250, 220, 90), 1.5)
+                self._put("step_radius", _circle(nx, ny, st["radius"], z, 64), NEAR_RGB, 1.5)
             near = [_circle(x, y, 0.4 * m, z, 8) for x, y, _ in st["near"]]
-            self._put("step_near", np.concatenate(near) if near else near, (250, 220, 90), 2.0)
+            self._put("step_near", np.concatenate(near) if near else near, NEAR_RGB, 2.0)
             self._put("step_parent", _edges([st["parent_edge"]], z), NEW_RGB, 5.0)
-        self._put("step_rewired", _edges([n for _, n in st["rewired"]], z), (80, 255, 220), 4.0)
+        self._put("step_was", _edges([r[0] for r in st["rewired"]], z - 1e-4), REWIRE_OLD_RGB,
+                  1.5)
+        self._put("step_rewired", _edges([r[1] for r in st["rewired"]], z), REWIRE_NEW_RGB, 4.0)
+        view = metres_per_px(self.camera) if self.camera is not None else None
+        for label in step_labels(st, self.bounds, self.look.scale, view):
+            self._label(*label)
 
     def _label(self, name: str, text: str, where, anchor: str) -> None:
         h = self._handles.get(name)
         pos = (*where, Z["step"])
         if h is None:
             self._handles[name] = self.scene.add_label(f"/live/{name}", text, position=pos,
-                                                       anchor=anchor)
+                                                       anchor=anchor,
+                                                       font_screen_scale=self.look.scale)
         else:
             h.position, h.text, h.anchor, h.visible = pos, text, anchor, True
 
@@ -154,3 +284,4 @@ class LiveView:
             h.remove()
         self._chunks.clear()
         self._handles.clear()
+        self._px.clear()

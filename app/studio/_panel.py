@@ -7,7 +7,9 @@ from dataclasses import dataclass
 import planner
 import tracks
 from app.studio._extend import FIRST_NOTE, render
+from app.studio._live_view import legend_html
 from app.studio._vehicle import APPLIED, FOOTPRINTS
+from app.studio._worker import STEP_CAP
 
 __all__ = ["DEFAULT_BUDGET", "MOTIONS", "PLANNERS", "SPEEDS", "STEERINGS", "TIMINGS", "Panel",
            "build_panel"]
@@ -74,6 +76,10 @@ class Panel:
     status: object
     metrics: object
     extend: object
+    # Step tools (issue 20)
+    planner_folder: object
+    step_node: object
+    step_rewire: object
     plots: object
 
 
@@ -129,7 +135,7 @@ def build_panel(gui) -> Panel:
                 hint="Distance planned paths keep from every obstacle and boundary"),
         }
         vehicle_note = gui.add_markdown(APPLIED)
-    with gui.add_folder("Planner"):
+    with gui.add_folder("Planner") as planner_folder:
         planner_name = gui.add_dropdown("Planner", tuple(PLANNERS), initial_value="RRT*")
         steering = gui.add_dropdown("Steering", tuple(STEERINGS))
         timing = gui.add_dropdown(
@@ -169,5 +175,15 @@ def build_panel(gui) -> Panel:
         metrics = gui.add_markdown("—")
     with gui.add_folder("EXTEND"):
         extend = gui.add_html(render(None, FIRST_NOTE))
+        gui.add_html(legend_html())
     plots = gui.add_folder("Profiles")
+    # Step tools (issue 20): in the Planner folder right after Step (a folder shows its rows
+    # by `order`).
+    with planner_folder:
+        step_node = gui.add_button(
+            "Step until a node is added", order=step.order + 0.3,
+            hint=f"Single iterations until one adds a node ({STEP_CAP:,} at most)")
+        step_rewire = gui.add_button(
+            "Step until a rewire", order=step.order + 0.6,
+            hint=f"Single iterations until one rewires the tree (RRT*; {STEP_CAP:,} at most)")
     return Panel(**{k: v for k, v in locals().items() if k != "gui"})

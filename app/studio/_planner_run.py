@@ -17,8 +17,8 @@ from pydantic import ValidationError
 import planner
 import tracks
 from app.raceline import path_raceline, raceline_limits
-from app.studio._extend import FIRST_NOTE, explain, render
-from app.studio._live_view import LiveView
+from app.studio._extend import FIRST_NOTE, explain, near_note, render, until_note
+from app.studio._live_view import LiveView, Look
 from app.studio._panel import DEFAULT_BUDGET, PLANNERS, SPEEDS, STEERINGS, TIMINGS
 from app.studio._plots import Profiles
 from app.studio._scenario import goal_fraction
@@ -41,6 +41,7 @@ class PlannerRun:
         self._profiles: Profiles | None = None
         self._car = None
         self._shown: dict = {}  # versions of the worker's record already shown
+        self.look = Look()
 
     def new_track(self, track: tracks.Track, vehicle) -> None:
         """The stage cleared the scene (the run's drawing went with it): profile plots of the
@@ -86,7 +87,8 @@ class PlannerRun:
             options = planner.PlanOptions(iterations=DEFAULT_BUDGET)
         self.worker = PlannerWorker(problem, options, options.iterations,
                                     SPEEDS[self.ui.rate.value])
-        self._view = LiveView(self.scene, self.worker.live, marker_size(problem.bounds))
+        self._view = LiveView(self.scene, self.worker.live, problem.bounds, self.look,
+                              self.stage.client.camera)
         self._shown = {"metrics": -1, "best": 0, "step": 0}
         self._driving = False
         if self._car is not None:
@@ -103,6 +105,13 @@ class PlannerRun:
 
     def set_rate(self) -> None:
         self.worker.rate = SPEEDS[self.ui.rate.value]
+
+    def step(self, until: str | None = None) -> None:
+        """`Step`, `Step until a node is added` ("node"), `Step until a rewire` ("rewire")."""
+        if until == "rewire" and self.ui.planner_name.value != "RRT*":
+            self.notify("RRT never rewires", "choose the planner RRT* to see rewires")
+            return
+        self.worker.step(until)
 
     def raceline(self) -> str | None:
         """The best path in the TUM raceline layout within the scenario vehicle's limits (None
@@ -165,9 +174,11 @@ class PlannerRun:
             self._profiles.show_cost(list(live.cost_over_time))
         if live.step_version != self._shown["step"] and live.step is not None:
             self._shown["step"] = live.step_version
-            line, note = explain(live.step["info"], live.step["star"])
-            self.ui.extend.content = render(line, f"Iteration {live.step['info'].iteration}: "
-                                                  + note)
+            step = live.step
+            line, note = explain(step["info"], step["star"])
+            self.ui.extend.content = render(line, until_note(*step["until"]),
+                                            f"Iteration {step['info'].iteration}: {note}",
+                                            near_note(step["info"], step["options"]))
 
 
 def pose_at_time(path: np.ndarray, t: float) -> tuple[float, float, float]:

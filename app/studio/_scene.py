@@ -14,8 +14,9 @@ import shapely
 import planner
 from planner.problem import follow_waypoints
 
-__all__ = ["DRAFT_RGB", "Z", "add_grid", "car_outline", "curvature_colors", "draw_car",
-           "draw_obstacles", "draw_poses", "draw_track", "fit_camera", "marker_size",
+__all__ = ["CURVATURE_RGB", "DRAFT_RGB", "GOAL_RGB", "MOVER_RGB", "OBSTACLE_RGB", "START_RGB", "Z",
+           "add_grid", "car_outline", "curvature_colors", "draw_car", "draw_obstacles",
+           "draw_poses", "draw_track", "fit_camera", "marker_size", "metres_per_px",
            "motion_table", "move_obstacles", "obstacle_rings", "obstacle_shape", "offset_at",
            "polyline_segments", "wxyz_yaw", "yaw_wxyz"]
 
@@ -25,6 +26,9 @@ Z = {"surface": -0.02, "centre": 0.002, "tree": 0.006, "flash": 0.008, "obstacle
 CAR_RGB, CAR_LINE_RGB = (250, 250, 250), (20, 20, 20)
 DISCS_RGB, MARGIN_RGB = (120, 120, 120), (235, 235, 235)  # checked discs, margin's dashes
 DRAFT_RGB = (255, 120, 0)  # what is being clicked: polygon corners, a drawn track
+START_RGB, GOAL_RGB = (60, 200, 90), (250, 200, 40)
+OBSTACLE_RGB, MOVER_RGB = (200, 60, 60), (230, 140, 40)  # static and moving obstacles
+CURVATURE_RGB = ((60, 130, 255), (250, 210, 60), (235, 50, 40))  # straight, half, the limit
 
 
 def polyline_segments(pts: np.ndarray, z: float, closed: bool = False) -> np.ndarray:
@@ -41,7 +45,7 @@ def polyline_segments(pts: np.ndarray, z: float, closed: bool = False) -> np.nda
 def curvature_colors(kappa: np.ndarray, kappa_max: float) -> np.ndarray:
     """Blue (straight) → yellow → red (at the car's limit 1/ρ and beyond), one RGB per value."""
     u = np.clip(np.abs(kappa) / kappa_max, 0.0, 1.0)[:, None]
-    blue, yellow, red = np.array([60, 130, 255]), np.array([250, 210, 60]), np.array([235, 50, 40])
+    blue, yellow, red = (np.array(rgb) for rgb in CURVATURE_RGB)
     lo = blue + (yellow - blue) * np.clip(2 * u, 0, 1)
     return np.where(u < 0.5, lo, yellow + (red - yellow) * np.clip(2 * u - 1, 0, 1)).astype(
         np.uint8)
@@ -152,7 +156,7 @@ def draw_obstacles(scene, scenario: planner.Scenario, track) -> list[tuple]:
         frame = scene.add_frame(f"/obstacles/o{i}", show_axes=False, position=(*pose[:2], 0.0),
                                 wxyz=yaw_wxyz(pose[2]))
         _fill(scene, f"/obstacles/o{i}/shape", [local], Z["obstacle"],
-              (230, 140, 40) if ob.motion is not None else (200, 60, 60))
+              MOVER_RGB if ob.motion is not None else OBSTACLE_RGB)
         out.append((frame, pose, motion_table(ob.motion, track)))
     return out
 
@@ -227,15 +231,15 @@ def draw_poses(scene, scenario: planner.Scenario, size: float) -> dict:
     """Start (green) and goal (gold) as car footprints in frames ``/poses/start`` and
     ``/poses/goal`` (dragging moves the frame); the goal's tolerance disc. Returns the frames."""
     frames = {}
-    for name, pose, rgb in (("start", scenario.start, (60, 200, 90)),
-                            ("goal", scenario.goal, (250, 200, 40))):
+    for name, pose, rgb in (("start", scenario.start, START_RGB),
+                            ("goal", scenario.goal, GOAL_RGB)):
         frames[name] = scene.add_frame(f"/poses/{name}", show_axes=False, position=(*pose[:2], 0.0),
                         wxyz=yaw_wxyz(pose[2]))
         _fill(scene, f"/poses/{name}/shape", [car_outline(size, 0.5 * size)], Z["pose"], rgb)
     a = np.linspace(0, 2 * math.pi, 48, endpoint=False)
     ring = scenario.goal_tolerance.position * np.column_stack([np.cos(a), np.sin(a)])
     scene.add_line_segments("/poses/goal/tol", polyline_segments(ring, Z["pose"], closed=True),
-                            (250, 200, 40), thickness=1.5, thickness_units="screen")
+                            GOAL_RGB, thickness=1.5, thickness_units="screen")
     return frames
 
 
@@ -249,6 +253,15 @@ def add_grid(scene, bounds) -> None:
     scene.add_grid("/grid", size, size, plane="xy", cell_size=cell, section_size=5 * cell,
                    position=((xmin + xmax) / 2, (ymin + ymax) / 2, Z["surface"] - 0.01 * cell),
                    cell_color=(225, 225, 225), section_color=(190, 190, 190))
+
+
+def metres_per_px(camera) -> float | None:
+    """The size of a screen pixel on the ground at the centre of the view (the camera looks
+    down, as `fit_camera` puts it); None before the browser has reported its camera."""
+    if camera.update_timestamp == 0.0:
+        return None
+    distance = float(np.linalg.norm(np.subtract(camera.position, camera.look_at)))
+    return 2 * distance * math.tan(camera.fov / 2) / camera.image_height
 
 
 def fit_camera(client, bounds, fov_deg: float = 20.0, usable: float = 0.72,

@@ -27,6 +27,7 @@ __all__ = ["Live", "PlannerWorker"]
 
 BATCH_S = 0.005
 FLASH_S = 0.6
+STEP_CAP = 10_000  # iterations one "step until" takes at most (RRT never rewires)
 
 
 @dataclass
@@ -65,6 +66,8 @@ class PlannerWorker:
         self._star = options.planner == "rrtstar"
         self._cmds: queue.Queue[str] = queue.Queue()
         self._stepping = False
+        self._step: dict | None = None  # the last single iteration, not yet shown
+        self._costs_before = None  # the tree's costs before it: a rewired node's old cost
         self._best = None
         self._clearance = self._clearance_of = None  # the best path's, and of which cost
         self._wall = 0.0  # s the run took: planning and the Speed throttle's sleeps
@@ -80,8 +83,10 @@ class PlannerWorker:
     def pause(self) -> None:
         self._cmds.put("pause")
 
-    def step(self) -> None:
-        self._cmds.put("step")
+    def step(self, until: str | None = None) -> None:
+        """One iteration; with ``until`` ("node" or "rewire") single iterations until one adds
+        a node or rewires (`STEP_CAP` at most). The last one is shown."""
+        self._cmds.put(f"step {until}" if until else "step")
 
     def stop(self) -> None:
         self._cmds.put("stop")
@@ -106,9 +111,9 @@ class PlannerWorker:
             elif cmd == "pause":
                 running = False
                 self._publish_metrics()
-            elif cmd == "step" and not self._done():
+            elif cmd and cmd.startswith("step") and not self._done():
                 running = False
-                self._advance(1, stepping=True)
+                self._step_until(cmd.partition(" ")[2] or None)
             self.live.state = "done" if self._done() else ("running" if running else "paused")
             if running:
                 n = batch if self.rate is None else max(1, int(self.rate * BATCH_S))
@@ -126,9 +131,26 @@ class PlannerWorker:
     def _done(self) -> bool:
         return self._run.finished or self._stepped >= self.budget
 
+    def _step_until(self, until: str | None) -> None:
+        """Single iterations until the last one did ``until`` (see `step`); the last one is
+        published with how many it took and whether ``until`` happened."""
+        self._step = None
+        for count in range(1, (STEP_CAP if until else 1) + 1):
+            self._advance(1, stepping=True)
+            info = self._step and self._step["info"]
+            found = info is not None and (info.new >= 0 if until == "node" else info.n_rewired > 0)
+            if until is None or found or self._done():
+                break
+        if self._step is not None:
+            outcome = "found" if found else ("done" if self._done() else "cap")
+            self.live.step = dict(self._step, until=(until, count, outcome))
+            self.live.step_version += 1
+
     def _advance(self, n: int, stepping: bool = False) -> float:
         t0 = time.perf_counter()
         self._stepping = stepping
+        if stepping:
+            self._costs_before = self._tree.costs.copy()
         try:
             self._run.step(n)
             self._stepped += n
@@ -162,22 +184,31 @@ class PlannerWorker:
             new = tree.edge_points(node, SEG)
             live.chunks.set(node, new)
             live.flashes.append((now, old, new))
-            rewired.append((old, new))
+            rewired.append((old, new, node))
         if self._stepping and len(ev):
             self._note_step(ev, rewired)
         self._note_best(now)
 
     def _note_step(self, ev: planner.TreeEvents, rewired: list) -> None:
-        pose = self._tree.poses
+        """The iteration as the step overlay and the EXTEND panel show it: a blocked Steer's
+        motion, and each rewired node's edges with its cost before and after."""
+        tree = self._tree
+        pose, cost = tree.poses, tree.costs
         info = StepInfo.from_events(ev, -1, len(rewired))
-        self.live.step = {
-            "info": info, "star": self._star, "x_rand": ev.sample[-1].copy(),
+        blocked = info.nearest >= 0 and info.new < 0
+        self._step = {
+            "info": info, "star": self._star, "options": tree.options,
+            "x_rand": ev.sample[-1].copy(),
             "nearest": pose[info.nearest].copy() if info.nearest >= 0 else None,
             "new": pose[info.new].copy() if info.new >= 0 else None,
+            "blocked": ((ev.steered[-1].copy(),
+                         tree.steer_points(pose[info.nearest], ev.steered[-1], SEG))
+                        if blocked else None),
             "parent_edge": (self.live.chunks.get(info.new) if info.new >= 0 else None),
-            "near": pose[ev.near_of(-1)].copy(), "radius": info.radius, "rewired": rewired,
+            "near": pose[ev.near_of(-1)].copy(), "radius": info.radius,
+            "rewired": [(old, new, float(self._costs_before[node]), float(cost[node]))
+                        for old, new, node in rewired],
         }
-        self.live.step_version += 1
 
     def _note_best(self, now: float) -> None:
         tree, live = self._tree, self.live
