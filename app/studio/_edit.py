@@ -28,6 +28,7 @@ class Editor:
         self._apply, self._track_click, self.notify = apply, track_click, notify
         self._selected: int | None = None  # the obstacle `Set motion of selected` changes
         self._gizmos: list = []
+        self._hidden = False  # projector mode hides the gizmos while a run is going
         self._polygon: list[tuple[float, float]] = []  # corners of a polygon being clicked
         self._click_mode: str | None = None
 
@@ -37,7 +38,7 @@ class Editor:
         for h in self._gizmos:
             h.remove()
         self._gizmos = []
-        parsed, visible = self.stage.parsed, bool(self.ui.handles.value)
+        parsed, visible = self.stage.parsed, self._gizmos_visible
         for i, ob in enumerate(parsed.obstacles):
             pose, _ = obstacle_shape(ob)
             self._gizmos.append(gizmo(
@@ -58,9 +59,20 @@ class Editor:
         """The scene was cleared, and the gizmos with it."""
         self._gizmos = []
 
+    @property
+    def _gizmos_visible(self) -> bool:
+        return bool(self.ui.handles.value) and not self._hidden
+
     def show_gizmos(self) -> None:
         for h in self._gizmos:
-            h.visible = bool(self.ui.handles.value)
+            h.visible = self._gizmos_visible
+
+    def hide_gizmos(self, hidden: bool) -> None:
+        """Hide the gizmos (projector mode, while a run is going), or show them again as
+        `Drag handles` says."""
+        if hidden != self._hidden:
+            self._hidden = hidden
+            self.show_gizmos()
 
     def _commit_obstacle(self, i: int, x: float, y: float, yaw: float) -> None:
         stage = self.stage

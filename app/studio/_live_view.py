@@ -184,6 +184,17 @@ class LiveView:
         self._ticks = 0
         self.sent_chunks = 0
 
+    def restyle(self, look: Look) -> None:
+        """Draw what is there, and what comes, with ``look``."""
+        self.look = look
+        for h in self._chunks.values():
+            h.thickness, h.colors = TREE_PX * look.scale, np.array(look.tree_rgb)
+        for name, h in self._handles.items():
+            if name in self._px:
+                h.thickness = self._px[name] * look.scale
+            else:
+                h.font_screen_scale = look.scale
+
     def _put(self, name: str, seg: np.ndarray, rgb, px: float, z: float | None = None):
         """Create or update a line-segments node (hidden when empty); ``px`` at scale 1."""
         h = self._handles.get(name)

@@ -76,10 +76,14 @@ class Panel:
     status: object
     metrics: object
     extend: object
-    # Step tools (issue 20)
+    # Step tools and the View folder (issue 20)
     planner_folder: object
+    extend_folder: object
     step_node: object
     step_rewire: object
+    projector: object
+    fade_tree: object
+    projector_css: object
     plots: object
 
 
@@ -173,12 +177,12 @@ def build_panel(gui) -> Panel:
         status = gui.add_markdown("Status: ready")
     with gui.add_folder("Metrics"):
         metrics = gui.add_markdown("—")
-    with gui.add_folder("EXTEND"):
+    with gui.add_folder("EXTEND") as extend_folder:
         extend = gui.add_html(render(None, FIRST_NOTE))
         gui.add_html(legend_html())
     plots = gui.add_folder("Profiles")
     # Step tools (issue 20): in the Planner folder right after Step (a folder shows its rows
-    # by `order`).
+    # by `order`), and the View folder, first in the panel.
     with planner_folder:
         step_node = gui.add_button(
             "Step until a node is added", order=step.order + 0.3,
@@ -186,4 +190,13 @@ def build_panel(gui) -> Panel:
         step_rewire = gui.add_button(
             "Step until a rewire", order=step.order + 0.6,
             hint=f"Single iterations until one rewires the tree (RRT*; {STEP_CAP:,} at most)")
+    with gui.add_folder("View", order=-10):
+        projector = gui.add_checkbox(
+            "Projector mode", False,
+            hint="Larger text, lines and labels, the run controls on top, no gizmos once a "
+                 "run has started (Reset brings them back), the view fitted beside the panel")
+        fade_tree = gui.add_checkbox("Fade the tree", False,
+                                     hint="Draw the tree dim, so the best path and a step "
+                                          "stand out")
+        projector_css = gui.add_html("")
     return Panel(**{k: v for k, v in locals().items() if k != "gui"})

@@ -113,6 +113,17 @@ class PlannerRun:
             return
         self.worker.step(until)
 
+    @property
+    def started(self) -> bool:
+        """Whether the run has iterated (a `reset` starts a new one)."""
+        return self.worker is not None and self.worker.started
+
+    def set_look(self, look: Look) -> None:
+        """Draw the run, now and from now on, with ``look`` (projector mode, a faded tree)."""
+        self.look = look
+        if self._view is not None:
+            self._view.restyle(look)
+
     def raceline(self) -> str | None:
         """The best path in the TUM raceline layout within the scenario vehicle's limits (None
         before a path is found)."""

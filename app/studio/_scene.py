@@ -264,11 +264,12 @@ def metres_per_px(camera) -> float | None:
     return 2 * distance * math.tan(camera.fov / 2) / camera.image_height
 
 
-def fit_camera(client, bounds, fov_deg: float = 20.0, usable: float = 0.72,
+def fit_camera(client, bounds, panel_px: float, fov_deg: float = 20.0,
                min_height: float = 20.0) -> None:
     """Look straight down on ``bounds`` with a narrow field of view (nearly orthographic),
-    slightly off the pole so the orbit controls keep +y up on screen. The GUI panel covers the
-    right of the canvas, so the scene is centred in the left ``usable`` fraction.
+    slightly off the pole so the orbit controls keep +y up on screen. The GUI panel floats
+    over the right of the canvas, ``panel_px`` wide (15 px from the edge): the scene is centred
+    in what is left of the canvas, so at any window width the panel covers none of it.
 
     The layers sit millimetres to centimetres apart in height (`Z`); seen from close above, a
     small track (30 cm drawn in mm) would show them shifted by parallax. So the camera never
@@ -277,6 +278,7 @@ def fit_camera(client, bounds, fov_deg: float = 20.0, usable: float = 0.72,
     cx, cy = (xmin + xmax) / 2, (ymin + ymax) / 2
     tanf = math.tan(math.radians(fov_deg) / 2)
     aspect = client.camera.aspect if client.camera.aspect > 0 else 1.5
+    usable = min(max(1.0 - (panel_px + 15) / client.camera.image_width, 0.25), 1.0)
     h = max(0.55 * (ymax - ymin) / tanf, 0.55 * (xmax - xmin) / usable / (tanf * aspect))
     if h < min_height:
         tanf, h = tanf * h / min_height, min_height

@@ -29,6 +29,7 @@ from app.studio._clock import SceneClock
 from app.studio._edit import Editor
 from app.studio._panel import build_panel
 from app.studio._planner_run import PlannerRun
+from app.studio._projector import Projector
 from app.studio._sim_view import SimView
 from app.studio._sources import Sources
 from app.studio._stage import Stage
@@ -61,6 +62,7 @@ class Session:
         self.vehicle = VehicleForm(u.vehicle, u.vehicle_note,
                                    lambda: self.stage.scenario.get("vehicle", {}), self.set_vehicle)
         self.studies = StudiesView(client.gui, client, api_url, self.notify)
+        self.projector = Projector(client.gui, u)
         self._wire()
         self._unfitted_ticks = 10  # fit the view this many ticks after the browser's camera
         self.sources.show_library("thesis")
@@ -69,12 +71,12 @@ class Session:
 
     def _wire(self) -> None:
         """Each control to the part that owns what it changes."""
-        u, stage, run, sim = self.ui, self.stage, self.planning, self.sim
+        u, run, sim = self.ui, self.planning, self.sim
         src, edit, drawing = self.sources, self.editor, self.drawing
         u.track.on_update(lambda _: src.track_chosen())
         u.svg_upload.on_upload(lambda _: src.svg_uploaded())
         u.svg_path.on_update(lambda _: src.svg_path_chosen())
-        u.fit.on_click(lambda _: stage.fit())
+        u.fit.on_click(lambda _: self.fit_view())
         u.draw.on_update(lambda _: edit.click_mode("track"))
         u.draw_undo.on_click(lambda _: drawing.undo())
         u.draw_close.on_update(lambda _: drawing.changed())
@@ -102,6 +104,8 @@ class Session:
         u.step.on_click(lambda _: run.step())
         u.step_node.on_click(lambda _: run.step("node"))
         u.step_rewire.on_click(lambda _: run.step("rewire"))
+        u.projector.on_update(lambda _: self._locked(self._show_projector))
+        u.fade_tree.on_update(lambda _: self._locked(lambda: run.set_look(self.projector.look)))
         u.drive.on_click(lambda _: self._locked(run.drive))
         u.raceline_download.on_click(lambda _: self._download_raceline())
         u.animation_download.on_click(lambda _: self._download_animation())
@@ -111,6 +115,15 @@ class Session:
     def _locked(self, fn) -> None:
         with self._lock:
             fn()
+
+    def fit_view(self) -> None:
+        """The whole scenario in view, beside the panel as wide as it is now."""
+        self.stage.fit(self.projector.panel_px)
+
+    def _show_projector(self) -> None:
+        self.projector.apply()
+        self.planning.set_look(self.projector.look)
+        self.fit_view()
 
     # -- what spans parts ----------------------------------------------------------------------
     def set_track(self, track: tracks.Track, scenario: dict, fit: bool = True) -> None:
@@ -125,7 +138,7 @@ class Session:
             self.planning.new_track(track, vehicle)
             self.apply_scenario(scenario)
             if fit:
-                self.stage.fit()
+                self.fit_view()
 
     def set_vehicle(self, vehicle: dict) -> str | None:
         """The scenario with a new car, or why it cannot have it (the start or goal no longer
@@ -233,7 +246,8 @@ class Session:
             # after: fit a moment later.
             self._unfitted_ticks -= 1
             if self._unfitted_ticks == 0:
-                self.stage.fit()
+                self.fit_view()
+        self.editor.hide_gizmos(self.projector.on and self.planning.started)
         self.planning.tick()
         self.sim.tick()
         self.clock.advance(self.planning.drive_end)

@@ -76,10 +76,11 @@ class Stage:
         """The scenario as planned (a custom track embedded), named ``name``."""
         return json.dumps(dict(self.scenario, name=name), indent=2)
 
-    def fit(self) -> None:
-        """Look at the whole scenario, once the browser has reported its camera."""
+    def fit(self, panel_px: float) -> None:
+        """Look at the whole scenario beside a panel ``panel_px`` wide, once the browser has
+        reported its camera."""
         if self.problem is not None and self.client.camera.update_timestamp != 0.0:
-            fit_camera(self.client, self.problem.bounds)
+            fit_camera(self.client, self.problem.bounds, panel_px)
 
 
 def _move_frame(frame, x: float, y: float, yaw: float) -> None:

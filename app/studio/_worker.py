@@ -93,6 +93,11 @@ class PlannerWorker:
         self._thread.join(timeout=2.0)
 
     @property
+    def started(self) -> bool:
+        """Whether the run has iterated."""
+        return self._stepped > 0
+
+    @property
     def iterations_per_s(self) -> float:
         return self._tree.iterations / self._wall if self._wall > 0 else 0.0
 
