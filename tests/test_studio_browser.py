@@ -218,6 +218,27 @@ def test_step_highlights_a_line_of_extend_and_draws_the_iteration(browser, ui_ur
     after = canvas_pixels(page, "04_step")
     assert np.abs(after - before).sum(axis=2).astype(bool).sum() > 100  # the step overlay
     page.screenshot(path=str(ARTIFACTS / "05_extend_panel.png"))
+    # Step tools: single iterations to the first rewire, with r(n) and its numbers; a legend.
+    click(page, "Step until a rewire")
+    page.locator("p", has_text="until a rewire.").wait_for(timeout=30000)
+    assert panel.locator("mark").inner_text().strip()[0] == "8"  # for x ∈ X_near …: Rewire
+    radius = page.locator("p", has_text="Near radius").inner_text()
+    assert re.search(r"r\(n\) = min\(γ·\(log n / n\)\^\(1/d\), ε\) = min\([\d.]+·\(log (\d+) / "
+                     r"\1\)\^\(1/3\), [\d.]+\) = min\([\d.]+, [\d.]+\) = [\d.]+ m", radius), radius
+    legend = page.locator("div", has_text="blocked Steer").filter(has_text="start").last
+    legend = legend.inner_text()
+    for colour in ("tree", "best path", "x_rand", "x_nearest", "x_new", "near set", "rewire",
+                   "blocked Steer", "start", "goal"):
+        assert colour in legend
+    # Projector mode: the panel's text zoomed, Run at the top of the panel, in sight.
+    font = "() => { const pre = document.querySelector('pre'); " \
+           "return pre.currentCSSZoom * parseFloat(getComputedStyle(pre).fontSize); }"
+    small = page.evaluate(font)
+    page.get_by_text("Projector mode").click()
+    assert poll(lambda: page.evaluate(font), lambda px: px > 1.3 * small) > 1.3 * small
+    run = page.get_by_role("button", name="Run", exact=True).bounding_box()
+    assert run["y"] + run["height"] < 400, run
+    page.screenshot(path=str(ARTIFACTS / "05b_projector.png"))
     page.close()
 
 
