@@ -28,7 +28,7 @@ class Editor:
         self._apply, self._track_click, self.notify = apply, track_click, notify
         self._selected: int | None = None  # the obstacle `Set motion of selected` changes
         self._gizmos: list = []
-        self._hidden = False  # projector mode hides the gizmos while a run is going
+        self._hidden = False  # projector mode hides the gizmos once a run has started
         self._polygon: list[tuple[float, float]] = []  # corners of a polygon being clicked
         self._click_mode: str | None = None
 
@@ -68,7 +68,7 @@ class Editor:
             h.visible = self._gizmos_visible
 
     def hide_gizmos(self, hidden: bool) -> None:
-        """Hide the gizmos (projector mode, while a run is going), or show them again as
+        """Hide the gizmos (projector mode, once a run has started), or show them again as
         `Drag handles` says."""
         if hidden != self._hidden:
             self._hidden = hidden

@@ -32,8 +32,8 @@ __all__ = ["LEGEND", "LiveView", "Look", "legend_html", "place_labels", "step_la
 TREE_RGB = (70, 150, 235)
 TREE_FADED_RGB = (90, 98, 118)  # near the asphalt: the path and the step overlay stand out
 PATH_RGB = (255, 90, 200)
-RAND_RGB, NEAREST_RGB, NEW_RGB, NEAR_RGB = (255, 255, 255), (90, 170, 255), (80, 255, 120), (
-    250, 220, 90)
+RAND_RGB, NEAREST_RGB = (255, 255, 255), (90, 170, 255)
+NEW_RGB, NEAR_RGB = (80, 255, 120), (250, 220, 90)
 REWIRE_OLD_RGB, REWIRE_NEW_RGB = (255, 160, 60), (80, 255, 220)
 BLOCKED_RGB = (255, 40, 40)
 LEGEND = (  # (what, colour or colours, drawn as a line, a ring or a filled shape)

@@ -27,7 +27,7 @@ __all__ = ["Live", "PlannerWorker"]
 
 BATCH_S = 0.005
 FLASH_S = 0.6
-STEP_CAP = 10_000  # iterations one "step until" takes at most (RRT never rewires)
+STEP_CAP = 10_000  # iterations one "step until" takes at most
 
 
 @dataclass
@@ -66,7 +66,7 @@ class PlannerWorker:
         self._star = options.planner == "rrtstar"
         self._cmds: queue.Queue[str] = queue.Queue()
         self._stepping = False
-        self._step: dict | None = None  # the last single iteration, not yet shown
+        self._last_step: dict | None = None  # the last single iteration, not yet shown
         self._costs_before = None  # the tree's costs before it: a rewired node's old cost
         self._best = None
         self._clearance = self._clearance_of = None  # the best path's, and of which cost
@@ -118,7 +118,7 @@ class PlannerWorker:
                 self._publish_metrics()
             elif cmd and cmd.startswith("step") and not self._done():
                 running = False
-                self._step_until(cmd.partition(" ")[2] or None)
+                self._single_steps(cmd.partition(" ")[2] or None)
             self.live.state = "done" if self._done() else ("running" if running else "paused")
             if running:
                 n = batch if self.rate is None else max(1, int(self.rate * BATCH_S))
@@ -136,19 +136,19 @@ class PlannerWorker:
     def _done(self) -> bool:
         return self._run.finished or self._stepped >= self.budget
 
-    def _step_until(self, until: str | None) -> None:
-        """Single iterations until the last one did ``until`` (see `step`); the last one is
-        published with how many it took and whether ``until`` happened."""
-        self._step = None
+    def _single_steps(self, until: str | None) -> None:
+        """One iteration, or single iterations until one did ``until`` (see `step`); only the
+        last is published, with how many it took and how the search ended."""
+        self._last_step = found = None
         for count in range(1, (STEP_CAP if until else 1) + 1):
             self._advance(1, stepping=True)
-            info = self._step and self._step["info"]
-            found = info is not None and (info.new >= 0 if until == "node" else info.n_rewired > 0)
+            info = self._last_step and self._last_step["info"]
+            found = info and (info.new >= 0 if until == "node" else info.n_rewired > 0)
             if until is None or found or self._done():
                 break
-        if self._step is not None:
+        if self._last_step is not None:
             outcome = "found" if found else ("done" if self._done() else "cap")
-            self.live.step = dict(self._step, until=(until, count, outcome))
+            self.live.step = dict(self._last_step, until=(until, count, outcome))
             self.live.step_version += 1
 
     def _advance(self, n: int, stepping: bool = False) -> float:
@@ -201,7 +201,7 @@ class PlannerWorker:
         pose, cost = tree.poses, tree.costs
         info = StepInfo.from_events(ev, -1, len(rewired))
         blocked = info.nearest >= 0 and info.new < 0
-        self._step = {
+        self._last_step = {
             "info": info, "star": self._star, "options": tree.options,
             "x_rand": ev.sample[-1].copy(),
             "nearest": pose[info.nearest].copy() if info.nearest >= 0 else None,
