@@ -38,10 +38,10 @@ class PlannerRun:
         self.worker: PlannerWorker | None = None
         self._driving = False  # the car shows the best path at the scene time
         self._view: LiveView | None = None
+        self.look = Look()  # how it draws the run (`set_look`)
         self._profiles: Profiles | None = None
         self._car = None
         self._shown: dict = {}  # versions of the worker's record already shown
-        self.look = Look()
 
     def new_track(self, track: tracks.Track, vehicle) -> None:
         """The stage cleared the scene (the run's drawing went with it): profile plots of the
@@ -106,8 +106,8 @@ class PlannerRun:
     def set_rate(self) -> None:
         self.worker.rate = SPEEDS[self.ui.rate.value]
 
-    def step(self, until: str | None = None) -> None:
-        """`Step`, `Step until a node is added` ("node"), `Step until a rewire` ("rewire")."""
+    def step(self, until: str) -> None:
+        """`Step until a node is added` ("node") or `Step until a rewire` ("rewire")."""
         if until == "rewire" and self.ui.planner_name.value != "RRT*":
             self.notify("RRT never rewires", "choose the planner RRT* to see rewires")
             return

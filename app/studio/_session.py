@@ -77,6 +77,8 @@ class Session:
         u.svg_upload.on_upload(lambda _: src.svg_uploaded())
         u.svg_path.on_update(lambda _: src.svg_path_chosen())
         u.fit.on_click(lambda _: self.fit_view())
+        u.projector.on_update(lambda _: self._locked(self._show_projector))
+        u.fade_tree.on_update(lambda _: self._locked(lambda: run.set_look(self.projector.look)))
         u.draw.on_update(lambda _: edit.click_mode("track"))
         u.draw_undo.on_click(lambda _: drawing.undo())
         u.draw_close.on_update(lambda _: drawing.changed())
@@ -99,13 +101,11 @@ class Session:
             control.on_update(lambda _: self._locked(run.reset))
         u.reset.on_click(lambda _: self._locked(run.reset))
         u.rate.on_update(lambda _: run.set_rate())
-        u.run.on_click(lambda _: run.worker.run())
-        u.pause.on_click(lambda _: run.worker.pause())
-        u.step.on_click(lambda _: run.step())
         u.step_node.on_click(lambda _: run.step("node"))
         u.step_rewire.on_click(lambda _: run.step("rewire"))
-        u.projector.on_update(lambda _: self._locked(self._show_projector))
-        u.fade_tree.on_update(lambda _: self._locked(lambda: run.set_look(self.projector.look)))
+        u.run.on_click(lambda _: run.worker.run())
+        u.pause.on_click(lambda _: run.worker.pause())
+        u.step.on_click(lambda _: run.worker.step())
         u.drive.on_click(lambda _: self._locked(run.drive))
         u.raceline_download.on_click(lambda _: self._download_raceline())
         u.animation_download.on_click(lambda _: self._download_animation())
@@ -115,15 +115,6 @@ class Session:
     def _locked(self, fn) -> None:
         with self._lock:
             fn()
-
-    def fit_view(self) -> None:
-        """The whole scenario in view, beside the panel as wide as it is now."""
-        self.stage.fit(self.projector.panel_px)
-
-    def _show_projector(self) -> None:
-        self.projector.apply()
-        self.planning.set_look(self.projector.look)
-        self.fit_view()
 
     # -- what spans parts ----------------------------------------------------------------------
     def set_track(self, track: tracks.Track, scenario: dict, fit: bool = True) -> None:
@@ -178,6 +169,15 @@ class Session:
         with self._lock:
             self.stage.show_time(t)
             self.planning.show_car(t)
+
+    def fit_view(self) -> None:
+        """The whole scenario in view, beside the panel as wide as it is now."""
+        self.stage.fit(self.projector.panel_px)
+
+    def _show_projector(self) -> None:
+        self.projector.apply()
+        self.planning.set_look(self.projector.look)
+        self.fit_view()
 
     def _simulate(self) -> None:
         """`Simulate`: the planner's own run is reset out of the simulation's way."""
