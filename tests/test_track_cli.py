@@ -109,17 +109,17 @@ def test_plot_writes_a_figure(tmp_path):
         ),
     ],
 )
-def test_bad_input_exits_2_with_one_line_on_stderr_within_a_second(tmp_path, args, content):
+def test_bad_input_exits_2_with_one_line_on_stderr_quickly(tmp_path, args, content):
+    """Quickly: no hang (the entity bomb would expand to 10⁹ characters); a start takes about
+    0.5 s alone, and up to 3 s beside the other test worker's browser, so the bound is 5 s."""
     if content is not None:
         (tmp_path / args[1]).write_bytes(content)
     done, seconds = run(*args, cwd=tmp_path)
-    if seconds >= 1.0:  # a busy machine: time a second attempt before blaming the code
-        done, seconds = run(*args, cwd=tmp_path)
     assert done.returncode == 2
     assert done.stdout == ""
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: "), done.stderr
-    assert seconds < 1.0
+    assert seconds < 5.0
 
 
 def test_csv_in_export_and_raceline_out(tmp_path):
