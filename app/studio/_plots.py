@@ -32,6 +32,23 @@ def _on_grid(s_grid: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.interp(s_grid, s, v)
 
 
+def _for_uplot(data: tuple) -> tuple:
+    """uPlot seeds a series' y range with its first value and takes NaN for a number: a series
+    that starts with NaN (no path yet) leaves the chart empty. Such a series starts with its
+    own first number instead (with none, the chart's first): one value before a gap, which
+    draws no line."""
+    x, *ys = data
+    firsts = [v[np.isfinite(v)][:1] for v in ys]
+    fallback = next((f[0] for f in firsts if len(f)), 0.0)
+    out = []
+    for v, first in zip(ys, firsts):
+        if math.isnan(v[0]):
+            v = v.copy()
+            v[0] = first[0] if len(first) else fallback
+        out.append(v)
+    return (x, *out)
+
+
 def _series(label: str, stroke: str | None = None, width: float = 1.5, dash=None) -> dict:
     out: dict = {"label": label}
     if stroke:
@@ -56,7 +73,7 @@ class Profiles:
         self._kmax = math.tan(math.radians(max_steer_deg)) / wheelbase
         self._limits = limits
         band = ({"series": (3, 4), "fill": "rgba(80,200,120,0.12)"},)
-        kappa, steer, speed = self._profiles(np.zeros((0, 4)))
+        kappa, steer, speed = map(_for_uplot, self._profiles(np.zeros((0, 4))))
         common = {"aspect": 1.6, "bands": band, "legend": {"show": True}, "scales": NUMERIC_X}
         self.curvature = gui.add_uplot(
             kappa, (_series("s (m)"), _series("centreline κ", "#4a90e2"),
@@ -115,9 +132,9 @@ class Profiles:
 
     def show_path(self, path: np.ndarray) -> None:
         kappa, steer, speed = self._profiles(path)
-        self.curvature.data = kappa
-        self.steering.data = steer
-        self.speed.data = speed
+        self.curvature.data = _for_uplot(kappa)
+        self.steering.data = _for_uplot(steer)
+        self.speed.data = _for_uplot(speed)
 
     def show_cost(self, cost_over_time: list[tuple[float, float, int]]) -> None:
         """The planner's best cost against its planning time."""
