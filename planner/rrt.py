@@ -157,6 +157,11 @@ class Planner:
         return list(self._clock.cost_over_time)
 
     @property
+    def planning_time_s(self) -> float:
+        """Seconds spent planning so far: the clock of `cost_over_time`."""
+        return self._compute_time
+
+    @property
     def poses(self) -> np.ndarray:
         """A read-only *live* view of the nodes' poses: read it on the planner's thread (in a
         listener); `snapshot()` gives a copy for anywhere else."""

@@ -420,3 +420,93 @@ def test_step_until_a_rewire_stops_at_one_and_states_the_near_radius_it_used():
     assert term < step["options"].eps and info.radius == pytest.approx(term)
     assert note.endswith(f"= min({term:.2f}, {step['options'].eps:.2f}) = {info.radius:.2f} m "
                          f"(n = {nodes} nodes, d = 3: x, y, θ).")
+
+
+def test_pinned_runs_keep_their_colours_and_the_comparison_has_a_row_and_curves_for_each():
+    """Pins: four at most, a fifth replaces the oldest and takes its colour. The CSV has one
+    row per pinned run and the current one with that run's numbers; the plots get a series
+    per pin that matches its data, none starting with NaN (uPlot would then draw nothing) and
+    RRT's one solution held as a line; the PNG is the plots."""
+    import csv
+    import io
+    from types import SimpleNamespace
+
+    from PIL import Image
+
+    from app.raceline import raceline_limits
+    from app.studio._compare import (
+        CURRENT,
+        MAX_PINS,
+        PALETTE,
+        Pins,
+        Run,
+        comparison_csv,
+        comparison_png,
+    )
+    from app.studio._plots import Profiles
+    from app.studio._worker import PlannerWorker
+
+    problem = _problem()
+    workers = [PlannerWorker(problem, options, budget=600)
+               for options in (planner.PlanOptions(planner="rrt", seed=0),
+                               planner.PlanOptions(seed=0))]
+    try:
+        for worker in workers:  # side by side
+            worker.run()
+        for worker in workers:
+            _run_to_the_end(worker)
+    finally:
+        for worker in workers:
+            worker.stop()
+    rrt, star = (Run(w.options, w.live.metrics, w.live.best_path, w.live.cost_over_time, 0.44)
+                 for w in workers)
+    assert rrt.label == "RRT, Dubins, seed 0" and len(rrt.path) and len(star.path)
+
+    drawn = []
+    pins = Pins(SimpleNamespace(remove_by_name=lambda name: drawn.clear(),
+                                add_frame=lambda *a, **k: None,
+                                add_line_segments=lambda name, seg, rgb, **k: drawn.append(rgb)))
+    for run in (rrt, star, rrt, star, rrt):
+        pins.add(run)
+    pins.draw()
+    assert [p.name for p in pins.runs] == ["pin 2", "pin 3", "pin 4", "pin 5"]
+    assert len(drawn) == MAX_PINS and pins.runs[-1].colour == PALETTE[0]  # pin 1's
+    assert {p.colour for p in pins.runs} == set(PALETTE)
+
+    pins.clear()
+    pins.add(rrt)
+    pins.add(star)
+    compared = [*pins.runs, star]
+    rows = list(csv.DictReader(io.StringIO(comparison_csv(compared))))
+    assert [r["run"] for r in rows] == ["pin 1", "pin 2", "this run"]
+    assert [r["colour"] for r in rows] == [PALETTE[0], PALETTE[1], CURRENT]
+    assert [r["planner"] for r in rows] == ["rrt", "rrtstar", "rrtstar"]
+    for row, run in zip(rows, compared):
+        assert int(row["iterations"]) == run.metrics["iterations"]
+        assert float(row["cost"]) == pytest.approx(run.metrics["cost"], rel=1e-5)
+        assert float(row["length_m"]) == pytest.approx(float(row["cost"]), rel=1e-3)
+        assert 0 < float(row["time_to_first_solution_s"]) and float(row["min_clearance_m"]) >= 0
+        assert float(row["max_abs_curvature_per_m"]) <= 1 / problem.rho + 1e-6
+        assert row["timing"] == "constant" and row["waited_s"] == ""
+    assert "<b>pin 1</b>: RRT, Dubins, seed 0 — cost" in pins.legend_html()
+
+    charts = []
+    gui = SimpleNamespace(add_uplot=lambda data, series, **k: charts.append(
+        SimpleNamespace(data=data, series=series)) or charts[-1])
+    profiles = Profiles(gui, np.linspace(0, 14, 50), np.zeros(50), 10.0, 0.44, 26.0,
+                        raceline_limits(vehicle=problem.scenario.vehicle))
+    profiles.show_path(star.path)
+    profiles.show_cost(star)
+    profiles.set_pins(pins.runs)
+    curvature, steering, _, cost = charts
+    for chart in (curvature, steering, cost):
+        assert [s["label"] for s in chart.series[-2:]] in (
+            [f"pin 1{x}", f"pin 2{x}"] for x in (" κ", " δ", ""))
+        assert len(chart.series) == len(chart.data)
+        assert len({len(d) for d in chart.data}) == 1
+        assert not any(np.isnan(d[0]) for d in chart.data[1:])
+    held = cost.data[2]  # pin 1, RRT: its one cost to the axis' end
+    assert held[-1] == pytest.approx(rrt.metrics["cost"]) and np.isfinite(cost.data[1][-1])
+
+    png = comparison_png(compared, "thesis: compared runs")
+    assert Image.open(io.BytesIO(png)).size == (800, 900) and len(png) > 30_000

@@ -70,6 +70,11 @@ class Panel:
     pause: object
     step: object
     reset: object
+    pin: object
+    clear_pins: object
+    pins_legend: object
+    comparison_csv: object
+    comparison_png: object
     drive: object
     raceline_download: object
     animation_download: object
@@ -167,6 +172,18 @@ def build_panel(gui) -> Panel:
         pause = gui.add_button("Pause")
         step = gui.add_button("Step")
         reset = gui.add_button("Reset")
+        pin = gui.add_button(
+            "Pin this run", hint="Keeps this run's best path, profiles and cost over time "
+                                 "drawn in a colour of its own under the next runs (4 at most: "
+                                 "a fifth replaces the oldest)")
+        clear_pins = gui.add_button("Clear pins")
+        pins_legend = gui.add_html("", visible=False)
+        comparison_csv = gui.add_button(
+            "Download comparison (CSV)", hint="One row per pinned run and the current one")
+        comparison_png = gui.add_button(
+            "Download comparison plots (PNG)",
+            hint="Curvature, steering and best cost over time of the pinned runs and the "
+                 "current one")
         drive = gui.add_button("Drive car")
         raceline_download = gui.add_button("Download raceline (CSV)",
                                             hint="The best path in the TUM raceline layout")

@@ -1,9 +1,10 @@
 """The planner's run in one tab and everything that shows it: the worker, its live drawing, the
-profile plots, the `Status`, `Metrics` and `EXTEND` panels, and the car that drives the best
-path (`Drive car`).
+profile plots, the `Status`, `Metrics` and `EXTEND` panels, the car that drives the best path
+(`Drive car`) and the pinned runs it is compared with.
 
 `PlannerRun` is the only writer of those; it plans the stage's current problem, and any change
 of scenario or planner setting starts a fresh run (`reset`): the old tree belongs to the old one.
+The pins stay until `Clear pins` or another track.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from pydantic import ValidationError
 import planner
 import tracks
 from app.raceline import path_raceline, raceline_limits
+from app.studio._compare import Pins, Run
 from app.studio._extend import FIRST_NOTE, explain, near_note, render, until_note
 from app.studio._live_view import LiveView, Look
 from app.studio._panel import DEFAULT_BUDGET, PLANNERS, SPEEDS, STEERINGS, TIMINGS
@@ -42,10 +44,13 @@ class PlannerRun:
         self._profiles: Profiles | None = None
         self._car = None
         self._shown: dict = {}  # versions of the worker's record already shown
+        self.pins = Pins(scene)
+        self._track = None  # the pins' track
 
     def new_track(self, track: tracks.Track, vehicle) -> None:
         """The stage cleared the scene (the run's drawing went with it): profile plots of the
-        new track's centreline, for a vehicle of this size."""
+        new track's centreline, for a vehicle of this size. Pins stay on the same track (a
+        car's settings changed: they compare it with the car before)."""
         self._view, self._car = None, None
         if self._profiles is not None:
             for h in self._profiles.handles:
@@ -56,6 +61,10 @@ class PlannerRun:
                                       goal_fraction(track.closed) * track.length_m,
                                       vehicle.wheelbase, vehicle.max_steer_deg,
                                       raceline_limits(vehicle=vehicle))
+        if track is not self._track:
+            self._track = track
+            self.pins.clear()
+        self._show_pins()
 
     def options(self) -> planner.PlanOptions:
         """The planner panel as `PlanOptions`: 0 in a number field means "derived". Raises
@@ -89,7 +98,7 @@ class PlannerRun:
                                     SPEEDS[self.ui.rate.value])
         self._view = LiveView(self.scene, self.worker.live, problem.bounds, self.look,
                               self.stage.client.camera)
-        self._shown = {"metrics": -1, "best": 0, "step": 0}
+        self._shown = {"metrics": -1, "best": 0, "step": 0, "cost": 0}
         self._driving = False
         if self._car is not None:
             self._car.remove()
@@ -98,6 +107,7 @@ class PlannerRun:
         self.ui.extend.content = render(None, FIRST_NOTE)
         if self._profiles is not None:
             self._profiles.show_path(np.zeros((0, 4)))
+            self._profiles.show_cost(self.current())
 
     def stop(self) -> None:
         if self.worker is not None:
@@ -131,6 +141,43 @@ class PlannerRun:
         if path is None or not len(path):
             return None
         return path_raceline(path, raceline_limits(vehicle=self.stage.parsed.vehicle))
+
+    # -- compare runs --------------------------------------------------------------------------
+    def current(self) -> Run | None:
+        """The current run as compared: its record as the worker last published it (metrics at
+        most 0.5 s behind a running planner); None before the first run."""
+        if self.worker is None:
+            return None
+        live = self.worker.live
+        path = live.best_path if live.best_path is not None else np.zeros((0, 6))
+        return Run(self.worker.options, dict(live.metrics), path, list(live.cost_over_time),
+                   self.stage.parsed.vehicle.wheelbase)
+
+    def compared(self) -> list[Run]:
+        """The pinned runs, oldest first, and the current one."""
+        return [*self.pins.runs, self.current()]
+
+    def pin(self) -> None:
+        """`Pin this run`: its best path, profiles and cost over time stay drawn in a colour of
+        their own while the next runs grow over them."""
+        run = self.current()
+        if run is None or not len(run.path):
+            self.notify("No path yet", "press Run until a path to the goal is found")
+        elif any(p.path is run.path for p in self.pins.runs):
+            self.notify("Pinned already", "this run's best path is pinned as it is")
+        else:
+            self.pins.add(run)
+            self._show_pins()
+
+    def clear_pins(self) -> None:
+        self.pins.clear()
+        self._show_pins()
+
+    def _show_pins(self) -> None:
+        self.pins.draw()
+        self.ui.pins_legend.content = self.pins.legend_html()
+        self.ui.pins_legend.visible = bool(self.pins.runs)
+        self._profiles.set_pins(self.pins.runs)
 
     # -- the car -------------------------------------------------------------------------------
     def drive(self) -> None:
@@ -178,11 +225,8 @@ class PlannerRun:
         if live.metrics_version != self._shown["metrics"]:
             self._shown["metrics"] = live.metrics_version
             self.ui.metrics.content = _metrics_md(live.metrics)
-        slow_tick = time.monotonic() - self._shown.get("plotted", 0.0) > PLOT_S
-        if live.best_version != self._shown["best"] and live.best_path is not None and slow_tick:
-            self._shown["best"], self._shown["plotted"] = live.best_version, time.monotonic()
-            self._profiles.show_path(live.best_path)
-            self._profiles.show_cost(list(live.cost_over_time))
+        if time.monotonic() - self._shown.get("plotted", 0.0) > PLOT_S:
+            self._plot(live)
         if live.step_version != self._shown["step"] and live.step is not None:
             self._shown["step"] = live.step_version
             step = live.step
@@ -190,6 +234,16 @@ class PlannerRun:
             self.ui.extend.content = render(line, until_note(*step["until"]),
                                             f"Iteration {step['info'].iteration}: {note}",
                                             near_note(step["info"], step["options"]))
+
+    def _plot(self, live) -> None:
+        """The profiles when the best path changed, the cost curve when the metrics did (it
+        runs on to the planning time so far)."""
+        if live.best_version != self._shown["best"] and live.best_path is not None:
+            self._shown["best"], self._shown["plotted"] = live.best_version, time.monotonic()
+            self._profiles.show_path(live.best_path)
+        if live.metrics_version != self._shown["cost"]:
+            self._shown["cost"], self._shown["plotted"] = live.metrics_version, time.monotonic()
+            self._profiles.show_cost(self.current())
 
 
 def pose_at_time(path: np.ndarray, t: float) -> tuple[float, float, float]:

@@ -5,7 +5,8 @@ profile), under the shaded envelope min(v_max, √(a_lat/|κ|)); and the best co
 time.
 
 The x axis is shared arc length, so the centreline is cut to the stretch from the start to the
-goal — the part of the track the path is meant to follow.
+goal — the part of the track the path is meant to follow. Pinned runs (_compare.py) add their
+curvature, steering and cost curves in their colours; the current run is the best path's pink.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import math
 import numpy as np
 
 import tracks
+from app.studio._compare import CURRENT, arc_length, cost_curves
 
 __all__ = ["Profiles"]
 
@@ -32,11 +34,18 @@ def _on_grid(s_grid: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.interp(s_grid, s, v)
 
 
+def _along(s_grid: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """v(s) along a path at the grid points, none beyond its end (a longer pin sets the grid)."""
+    if len(s) < 2:
+        return np.full(len(s_grid), math.nan)
+    return np.interp(s_grid, s, v, right=math.nan)
+
+
 def _for_uplot(data: tuple) -> tuple:
     """uPlot seeds a series' y range with its first value and takes NaN for a number: a series
-    that starts with NaN (no path yet) leaves the chart empty. Such a series starts with its
-    own first number instead (with none, the chart's first): one value before a gap, which
-    draws no line."""
+    that starts with NaN (no path yet, a run solved later than another) leaves the chart
+    empty. Such a series starts with its own first number instead (with none, the chart's
+    first): one value before a gap, which draws no line (and no point: they are off)."""
     x, *ys = data
     firsts = [v[np.isfinite(v)][:1] for v in ys]
     fallback = next((f[0] for f in firsts if len(f)), 0.0)
@@ -49,8 +58,19 @@ def _for_uplot(data: tuple) -> tuple:
     return (x, *out)
 
 
+def _held(grid: np.ndarray, t: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """A best cost curve on the grid of times: each cost holds until the next, none before
+    the first solution or after the run's end."""
+    if not len(t):
+        return np.full(len(grid), math.nan)
+    k = np.searchsorted(t, grid, side="right") - 1
+    out = c[k.clip(0)]
+    out[(k < 0) | (grid > t[-1])] = math.nan
+    return out
+
+
 def _series(label: str, stroke: str | None = None, width: float = 1.5, dash=None) -> dict:
-    out: dict = {"label": label}
+    out: dict = {"label": label, "points": {"show": False}}
     if stroke:
         out |= {"stroke": stroke, "width": width}
     if dash:
@@ -68,6 +88,8 @@ class Profiles:
     def __init__(self, gui, centre_s, centre_kappa, goal_s: float, wheelbase: float,
                  max_steer_deg: float, limits: tracks.Limits) -> None:
         self._cs, self._ck = np.asarray(centre_s), np.asarray(centre_kappa)
+        self._pins: list = []  # `_compare.Run`s
+        self._path, self._current = np.zeros((0, 4)), None  # the current run, as shown
         self._goal_s = goal_s
         self._wb, self._dmax = wheelbase, max_steer_deg
         self._kmax = math.tan(math.radians(max_steer_deg)) / wheelbase
@@ -77,16 +99,16 @@ class Profiles:
         common = {"aspect": 1.6, "bands": band, "legend": {"show": True}, "scales": NUMERIC_X}
         self.curvature = gui.add_uplot(
             kappa, (_series("s (m)"), _series("centreline κ", "#4a90e2"),
-                    _series("path κ", "#e8542f", 2.0), _series("+κmax", "#2e9e5b", 1, [4, 4]),
+                    _series("path κ", CURRENT, 2.0), _series("+κmax", "#2e9e5b", 1, [4, 4]),
                     _series("−κmax", "#2e9e5b", 1, [4, 4])),
             title="Curvature κ (1/m) vs s", **common)
         self.steering = gui.add_uplot(
             steer, (_series("s (m)"), _series("centreline δ", "#4a90e2"),
-                    _series("path δ", "#e8542f", 2.0), _series("+δmax", "#2e9e5b", 1, [4, 4]),
+                    _series("path δ", CURRENT, 2.0), _series("+δmax", "#2e9e5b", 1, [4, 4]),
                     _series("−δmax", "#2e9e5b", 1, [4, 4])),
             title="Steering δ (deg) vs s", **common)
         self.speed = gui.add_uplot(
-            speed, (_series("s (m)"), _series("path v", "#e8542f", 2.0),
+            speed, (_series("s (m)"), _series("path v", CURRENT, 2.0),
                     _series(f"limit (v ≤ {limits.v_max:g}, a_lat ≤ {limits.a_lat:g}, "
                             f"|a_long| ≤ {limits.a_long:g})", "#2e9e5b", 1, [4, 4]),
                     _series("v = 0")),
@@ -94,29 +116,27 @@ class Profiles:
             **common | {"bands": ({"series": (2, 3), "fill": "rgba(80,200,120,0.12)"},)})
         self.cost = gui.add_uplot(
             (np.array([0.0, 1.0]), np.array([math.nan, math.nan])),
-            (_series("planning time (s)"), _series("best cost (m)", "#8e44ad", 2.0)),
+            (_series("planning time (s)"), _series("best cost (m)", CURRENT, 2.0)),
             title="Best cost over time", aspect=2.2, scales=NUMERIC_X)
+        self._series = [h.series for h in (self.curvature, self.steering, self.cost)]  # no pins
 
     @property
     def handles(self) -> tuple:
         return self.curvature, self.steering, self.speed, self.cost
 
     def _profiles(self, path: np.ndarray) -> tuple[tuple, tuple, tuple]:
-        """(curvature, steering data): x, centreline, path, +max, −max on one s grid; (speed
-        data): x, the path's speed, its envelope, 0."""
-        if len(path) >= 2:
-            ds = np.hypot(*np.diff(path[:, :2], axis=0).T)
-            ps = np.concatenate([[0.0], np.cumsum(ds)])
-            end = ps[-1]
-        else:
-            ps, end = np.zeros(0), self._goal_s
+        """(curvature, steering data): x, centreline, path, +max, −max, each pin on one s grid
+        as long as the longest path; (speed data): x, the path's speed, its envelope, 0."""
+        paths = [path, *(r.path for r in self._pins)]
+        end = max((arc_length(p)[-1] for p in paths if len(p) >= 2), default=self._goal_s)
         grid = np.linspace(0.0, max(end, 1e-3), N)
         centre = _on_grid(grid, self._cs, self._ck)
-        pk = _on_grid(grid, ps, path[:, 3]) if len(ps) else np.full(N, math.nan)
+        pk, *pins = [_along(grid, arc_length(p), p[:, 3]) for p in paths]
         one = np.ones(N)
-        kappa = (grid, centre, pk, self._kmax * one, -self._kmax * one)
+        kappa = (grid, centre, pk, self._kmax * one, -self._kmax * one, *pins)
         steer = (grid, _steer_deg(centre, self._wb), _steer_deg(pk, self._wb),
-                 self._dmax * one, -self._dmax * one)
+                 self._dmax * one, -self._dmax * one,
+                 *(_steer_deg(k, r.wheelbase) for k, r in zip(pins, self._pins)))
         return kappa, steer, self._speed(grid, path)
 
     def _speed(self, grid: np.ndarray, path: np.ndarray) -> tuple:
@@ -128,19 +148,35 @@ class Profiles:
         s, kappa, v = rows[:, 0], np.abs(rows[:, 4]), np.abs(rows[:, 5])
         cap = np.minimum(self._limits.v_max,
                          np.sqrt(self._limits.a_lat / np.maximum(kappa, 1e-300)))
-        return grid, _on_grid(grid, s, v), _on_grid(grid, s, cap), np.zeros(N)
+        return grid, _along(grid, s, v), _along(grid, s, cap), np.zeros(N)
 
     def show_path(self, path: np.ndarray) -> None:
+        self._path = path
         kappa, steer, speed = self._profiles(path)
         self.curvature.data = _for_uplot(kappa)
         self.steering.data = _for_uplot(steer)
         self.speed.data = _for_uplot(speed)
 
-    def show_cost(self, cost_over_time: list[tuple[float, float, int]]) -> None:
-        """The planner's best cost against its planning time."""
-        if not cost_over_time:
-            return
-        t, c = np.array(cost_over_time)[:, :2].T
-        if len(t) == 1:
-            t, c = np.array([t[0], t[0] + 1e-3]), np.array([c[0], c[0]])
-        self.cost.data = (t, c)
+    def show_cost(self, current) -> None:
+        """The current run's (a `_compare.Run`) best cost against planning time and the pinned
+        runs', on one time axis: each improvement's instant and the one just before it, so
+        that every curve is a staircase."""
+        self._current = current
+        curves = cost_curves([current, *self._pins])
+        t = np.unique(np.concatenate([np.r_[t, np.nextafter(t, -math.inf)] for t, _ in curves]))
+        if not len(t):
+            t = np.array([0.0, 1.0])
+        elif t[-1] - t[0] < 1e-3:  # one instant: the browser keeps its zoom relative to the span
+            t = np.r_[t, t[0] + 1e-3]
+        self.cost.data = _for_uplot((t, *(_held(t, *c) for c in curves)))
+
+    def set_pins(self, runs: list) -> None:
+        """Pinned runs (`_compare.Run`) as series of their own, named and coloured as the
+        pins; the caller sends it atomically, the series with the data that matches them."""
+        self._pins = list(runs)
+        for h, base, symbol in zip((self.curvature, self.steering, self.cost), self._series,
+                                   (" κ", " δ", "")):
+            h.series = base + tuple(_series(r.name + symbol, r.colour, 1.5) for r in runs)
+        self.show_path(self._path)
+        if self._current is not None:
+            self.show_cost(self._current)

@@ -22,7 +22,7 @@ __all__ = ["CURVATURE_RGB", "DRAFT_RGB", "GOAL_RGB", "MOVER_RGB", "OBSTACLE_RGB"
 
 # Obstacles above the tree: edges pass where a moving obstacle is at other times.
 Z = {"surface": -0.02, "centre": 0.002, "tree": 0.006, "flash": 0.008, "obstacle": 0.009,
-     "path": 0.01, "step": 0.012, "pose": 0.014, "car": 0.016}
+     "pin": 0.0095, "path": 0.01, "step": 0.012, "pose": 0.014, "car": 0.016}
 CAR_RGB, CAR_LINE_RGB = (250, 250, 250), (20, 20, 20)
 DISCS_RGB, MARGIN_RGB = (120, 120, 120), (235, 235, 235)  # checked discs, margin's dashes
 DRAFT_RGB = (255, 120, 0)  # what is being clicked: polygon corners, a drawn track

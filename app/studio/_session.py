@@ -26,6 +26,7 @@ import time
 import planner
 import tracks
 from app.studio._clock import SceneClock
+from app.studio._compare import comparison_csv, comparison_png
 from app.studio._edit import Editor
 from app.studio._panel import build_panel
 from app.studio._planner_run import PlannerRun
@@ -106,6 +107,10 @@ class Session:
         u.run.on_click(lambda _: run.worker.run())
         u.pause.on_click(lambda _: run.worker.pause())
         u.step.on_click(lambda _: run.worker.step())
+        u.pin.on_click(lambda _: self._pins_changed(run.pin))
+        u.clear_pins.on_click(lambda _: self._pins_changed(run.clear_pins))
+        u.comparison_csv.on_click(lambda _: self._download_comparison(png=False))
+        u.comparison_png.on_click(lambda _: self._download_comparison(png=True))
         u.drive.on_click(lambda _: self._locked(run.drive))
         u.raceline_download.on_click(lambda _: self._download_raceline())
         u.animation_download.on_click(lambda _: self._download_animation())
@@ -116,10 +121,16 @@ class Session:
         with self._lock:
             fn()
 
+    def _pins_changed(self, fn) -> None:
+        """Pin or clear: the plots' series and their data reach the browser together."""
+        with self.client.atomic(), self._lock:
+            fn()
+
     # -- what spans parts ----------------------------------------------------------------------
     def set_track(self, track: tracks.Track, scenario: dict, fit: bool = True) -> None:
-        """Show a new track with its scenario: a fresh scene, so every part draws anew."""
-        with self._lock:
+        """Show a new track with its scenario: a fresh scene, so every part draws anew (at
+        once: new plots with pins get their series and the data that matches them)."""
+        with self.client.atomic(), self._lock:
             vehicle = planner.parse_scenario(scenario).vehicle
             self.vehicle.show(vehicle)
             self.sim.clear()  # while its drawing is still in the scene
@@ -196,6 +207,17 @@ class Session:
             self.notify("No path yet", "press Run until a path to the goal is found")
             return
         self.client.send_file_download("raceline.csv", text.encode(), save_immediately=True)
+
+    def _download_comparison(self, png: bool) -> None:
+        """The pinned runs and the current one: their numbers as CSV or their plots as PNG."""
+        with self._lock:
+            runs, name = self.planning.compared(), self.stage.parsed.name
+        if png:
+            content = comparison_png(runs, f"{name}: compared runs")
+        else:
+            content = comparison_csv(runs).encode()
+        self.client.send_file_download(f"comparison.{'png' if png else 'csv'}", content,
+                                       save_immediately=True)
 
     def _download_animation(self) -> None:
         """The current settings' run drawn as a GIF, rendered on a thread of its own (a few

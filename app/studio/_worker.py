@@ -54,6 +54,7 @@ class PlannerWorker:
     def __init__(self, problem, options: planner.PlanOptions, budget: int,
                  rate: float | None = None) -> None:
         self.live = Live()
+        self.options = options  # as the panel gave them: what a pinned run is labelled with
         self.budget = budget
         self.rate = rate  # iterations per second, None: as fast as it goes
         self._problem = problem
@@ -249,7 +250,8 @@ class PlannerWorker:
         tree = self._tree
         out = {"iterations": tree.iterations, "nodes": tree.nodes, "rewires": tree.rewires,
                "time_to_first_solution_s": tree.time_to_first_solution_s,
-               "cost": tree.best_cost, "iterations_per_s": self.iterations_per_s}
+               "cost": tree.best_cost, "iterations_per_s": self.iterations_per_s,
+               "planning_time_s": tree.planning_time_s}
         if self._optimal:
             result = self._timed()
             return out | {"min_clearance_m": result.min_clearance_m,
