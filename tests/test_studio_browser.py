@@ -157,6 +157,11 @@ def pink_pixels(img: np.ndarray) -> int:
     return int((np.abs(img - [255, 90, 200]).sum(axis=2) < 60).sum())
 
 
+def pin_pixels(img: np.ndarray) -> int:
+    """Pixels of the first pinned run's violet (157, 78, 221), PALETTE[0] of _compare.py."""
+    return int((np.abs(img - [157, 78, 221]).sum(axis=2) < 60).sum())
+
+
 def metric(page, name: str) -> str:
     """The value cell of a row of the Metrics table, as a number."""
     cells = page.locator("tr", has_text=name).first.locator("td")
@@ -197,6 +202,23 @@ def test_scene_renders_a_library_track_and_run_grows_the_tree(browser, ui_url):
     legends = " ".join(page.locator(".u-legend").all_inner_texts())
     assert "s (m)" in legends and "1970" not in legends and not re.search(r"\d(am|pm)", legends)
     page.screenshot(path=str(ARTIFACTS / "03_profiles.png"))
+    # Compare runs: the pinned run stays drawn in its colour while a Reeds-Shepp run (which
+    # reverses to the goal: another path) grows over it, and the legend and plots name it.
+    assert pin_pixels(after) < 50
+    click(page, "Pin this run")
+    page.get_by_text(re.compile(r"pin 1: RRT\*, Dubins, seed 0 — cost \d")).wait_for()
+    page.get_by_label("Steering", exact=True).click(force=True)
+    page.get_by_role("option", name="Reeds-Shepp", exact=True).click(force=True)
+    # The new run's metrics are empty: Run goes to it, not to the paused one.
+    page.locator("tr", has_text="rewires").wait_for(state="detached")
+    click(page, "Run")
+    page.locator("tr", has_text="cost").first.get_by_text(re.compile(r"^[\d.]+ m$")).wait_for()
+    click(page, "Pause")  # once it has a path (a cost in the metrics)
+    compared = wait_until(page, lambda img: pin_pixels(img) > 300 and pink_pixels(img) > 200)
+    canvas_pixels(page, "14_compare")
+    assert pin_pixels(compared) > 300, "the pinned path is not drawn under the new run"
+    assert pink_pixels(compared) > 200, "the new run drew no path"
+    assert page.locator(".u-legend", has_text="pin 1 κ").count() == 1
     page.close()
 
 
