@@ -23,9 +23,10 @@ from app.studio._scene import Z, polyline_segments
 __all__ = ["CURRENT", "MAX_PINS", "PALETTE", "Pins", "Run", "arc_length", "comparison_csv",
            "comparison_png", "cost_curves"]
 
-# Violet, teal, lime, brown: none is the tree's blue, the path's pink, the obstacles' red or
-# orange, the start's green or the goal's gold, and each reads on the asphalt and on white.
-PALETTE = ("#9d4edd", "#00a89d", "#a3d92b", "#b5651d")
+# Violet, teal, sienna, olive: none is a colour another line in the scene has (the tree's
+# blue, the path's pink, the rewire flashes' red and green, the centreline's blue, yellow and
+# red, the step overlay's white, yellow and cyan), and each reads on the asphalt and on white.
+PALETTE = ("#9d4edd", "#00a89d", "#a0522d", "#808000")
 CURRENT = "#ff5ac8"  # the current run: the best path's pink (app/studio/_live_view.py)
 MAX_PINS = len(PALETTE)  # a pin beyond these replaces the oldest
 COLUMNS = ("run", "colour", "planner", "steering", "seed", "timing", "iterations", "cost",
