@@ -446,7 +446,7 @@ def test_pinned_runs_keep_their_colours_and_the_comparison_has_a_row_and_curves_
     from app.studio._plots import Profiles
     from app.studio._worker import PlannerWorker
 
-    problem = _problem()
+    problem = planner.compile_problem(planner.load_scenario("slalom"))  # quick to compile
     workers = [PlannerWorker(problem, options, budget=600)
                for options in (planner.PlanOptions(planner="rrt", seed=0),
                                planner.PlanOptions(seed=0))]
@@ -508,5 +508,5 @@ def test_pinned_runs_keep_their_colours_and_the_comparison_has_a_row_and_curves_
     held = cost.data[2]  # pin 1, RRT: its one cost to the axis' end
     assert held[-1] == pytest.approx(rrt.metrics["cost"]) and np.isfinite(cost.data[1][-1])
 
-    png = comparison_png(compared, "thesis: compared runs")
+    png = comparison_png(compared, "slalom: compared runs")
     assert Image.open(io.BytesIO(png)).size == (800, 900) and len(png) > 30_000
