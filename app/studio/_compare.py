@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 import planner
+from app.studio._live_view import PATH_RGB
 from app.studio._panel import PLANNERS, TIMINGS
 from app.studio._scene import Z, polyline_segments
 
@@ -27,7 +28,7 @@ __all__ = ["CURRENT", "MAX_PINS", "PALETTE", "Pins", "Run", "arc_length", "compa
 # blue, the path's pink, the rewire flashes' red and green, the centreline's blue, yellow and
 # red, the step overlay's white, yellow and cyan), and each reads on the asphalt and on white.
 PALETTE = ("#9d4edd", "#00a89d", "#a0522d", "#808000")
-CURRENT = "#ff5ac8"  # the current run: the best path's pink (app/studio/_live_view.py)
+CURRENT = "#{:02x}{:02x}{:02x}".format(*PATH_RGB)  # the current run: the best path's pink
 MAX_PINS = len(PALETTE)  # a pin beyond these replaces the oldest
 COLUMNS = ("run", "colour", "planner", "steering", "seed", "timing", "iterations", "cost",
            "cost_unit", "length_m", "time_to_first_solution_s", "min_clearance_m",
@@ -134,9 +135,10 @@ class Pins:
     def clear(self) -> None:
         self.runs, self._pinned = [], 0
 
-    def draw(self) -> None:
-        """The pinned paths, anew (also into a fresh scene, where the old ones are gone): one
-        line node per pin, since per-vertex colours would be drawn paler than the legend's."""
+    def draw(self, scale: float = 1.0) -> None:
+        """The pinned paths, anew (also into a fresh scene, where the old ones are gone), lines
+        ``scale`` times as wide (projector mode): one line node per pin, since per-vertex
+        colours would be drawn paler than the legend's."""
         self.scene.remove_by_name("/pins")
         if not self.runs:
             return
@@ -144,7 +146,7 @@ class Pins:
         for i, run in enumerate(self.runs):
             self.scene.add_line_segments(
                 f"/pins/{i}", polyline_segments(run.path[:, :2], Z["pin"]), _rgb(run.colour),
-                thickness=3.0, thickness_units="screen")
+                thickness=3.0 * scale, thickness_units="screen")
 
     def legend_html(self) -> str:
         """Each pin's colour, settings and result, then the current run's colour."""

@@ -133,6 +133,7 @@ class PlannerRun:
         self.look = look
         if self._view is not None:
             self._view.restyle(look)
+        self.pins.draw(look.scale)
 
     def raceline(self) -> str | None:
         """The best path in the TUM raceline layout within the scenario vehicle's limits (None
@@ -174,7 +175,7 @@ class PlannerRun:
         self._show_pins()
 
     def _show_pins(self) -> None:
-        self.pins.draw()
+        self.pins.draw(self.look.scale)
         self.ui.pins_legend.content = self.pins.legend_html()
         self.ui.pins_legend.visible = bool(self.pins.runs)
         self._profiles.set_pins(self.pins.runs)
