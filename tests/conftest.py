@@ -23,14 +23,10 @@ BROWSER_MODULES = {"test_studio_browser.py", "test_studio_sim_browser.py"}
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     """The groups of pyproject's ``-n 2 --dist loadgroup``: a module runs on one worker (its
-    servers start once) and the browser modules share one; they come first, being the longest
-    chain, while the other worker takes the rest."""
-    def group(item) -> str:
-        return "browser" if item.path.name in BROWSER_MODULES else item.path.name
-
+    servers start once) and the browser modules share one."""
     for item in items:
-        item.add_marker(pytest.mark.xdist_group(group(item)))
-    items.sort(key=lambda item: group(item) != "browser")
+        name = item.path.name
+        item.add_marker(pytest.mark.xdist_group("browser" if name in BROWSER_MODULES else name))
 
 
 def scenario_dict(name: str) -> dict:
