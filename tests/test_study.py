@@ -125,8 +125,11 @@ def test_ctrl_c_keeps_finished_runs_and_the_next_invocation_goes_on(study_file, 
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 90
     while time.monotonic() < deadline:
-        if (out / "results.sqlite").exists() and len(rows(out, ("id",))) >= 2:
-            break
+        try:
+            if (out / "results.sqlite").exists() and len(rows(out, ("id",))) >= 2:
+                break
+        except sqlite3.OperationalError:  # the file exists a moment before its tables
+            pass
         time.sleep(0.2)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=15)
