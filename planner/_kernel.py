@@ -27,7 +27,7 @@ import numpy as np
 from planner._dubins import turning_centres
 from planner._jit import njit
 from planner._paths import path_end, truncate, wrap_angle
-from planner._polish import polish_path
+from planner._polish import PASSES, in_goal, polish_path
 from planner._rng import uniform
 from planner._steer import (
     arrival_heading,
@@ -149,8 +149,7 @@ def add_node(tree: Tree, P: np.ndarray, x, y, th, cost, parent, kinds, lens) -> 
     tree.cell_next[k] = tree.cell_head[c]
     tree.cell_head[c] = k
     tree.cnt[N] = k + 1
-    if (math.hypot(x - P[GX], y - P[GY]) <= P[GPOS]
-            and abs(wrap_angle(th - P[GTH])) <= P[GHEAD]):
+    if in_goal(x, y, th, P[GX:GHEAD + 1]):
         tree.goal_nodes[tree.cnt[NGOAL]] = k
         tree.cnt[NGOAL] += 1
     return k
@@ -485,7 +484,8 @@ def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, counter, ev) 
     while node >= 0:
         n += 1
         node = tree.parent[node]
-    if n < 3 or tree.cnt[N] + n - 1 > tree.pose.shape[0]:
+    # Each pass at most doubles the edges: the chain must fit whatever polishing makes of it.
+    if n < 2 or tree.cnt[N] + (n - 1) * 2 ** PASSES > tree.pose.shape[0]:
         return False
     poses = np.empty((n, 3))
     node = root = tree.cnt[BEST]
@@ -494,11 +494,12 @@ def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, counter, ev) 
         root = node
         node = tree.parent[node]
     code = int(P[STEERING])
-    length = polish_path(w, code, P[RHO], P[SPEED], poses, kinds, lens, counter)
+    goal = np.array([P[GX], P[GY], P[GTH], P[GPOS], P[GHEAD]])
+    poses, length = polish_path(w, code, P[RHO], P[SPEED], poses, goal, kinds, lens, counter)
     if length >= tree.cost[tree.cnt[BEST]] - 1e-9:
         return False
     parent = root
-    for i in range(1, n):
+    for i in range(1, poses.shape[0]):
         a, b = poses[i - 1], poses[i]
         edge = steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], P[RHO], kinds, lens)
         parent = add_node(tree, P, b[0], b[1], b[2], tree.cost[parent] + edge, parent, kinds,

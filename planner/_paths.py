@@ -113,27 +113,26 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
 
     Returns an (n, 5) array of x, y, theta, curvature (steering curvature: kind/ρ), direction.
     A turn on the spot is one row: the same position, the new heading, curvature 0 (the robot
-    does not steer; its heading is free).
+    does not steer; its heading is free). A segment shorter than a micrometre (a Dubins word's
+    vanishing middle) moves the pose but gives no row: it would repeat the one before.
     """
     n = 1
+    first = -1
     for i in range(kinds.shape[0]):
-        if lens[i] != 0.0:
+        if _sampled(kinds[i], lens[i]):
             n += max(1, int(math.ceil(driven(kinds[i], lens[i]) / spacing - 1e-12)))
+            first = i if first < 0 else first
     out = np.empty((n, 5))
     out[0, 0] = x
     out[0, 1] = y
     out[0, 2] = th
-    first = -1
-    for i in range(kinds.shape[0]):
-        if lens[i] != 0.0:
-            first = i
-            break
     out[0, 3] = _curvature(kinds[first], rho) if first >= 0 else 0.0
     out[0, 4] = _direction(kinds[first], lens[first]) if first >= 0 else 1.0
     k = 1
     for i in range(kinds.shape[0]):
         seg = lens[i]
-        if seg == 0.0:
+        if not _sampled(kinds[i], seg):
+            x, y, th = advance(x, y, th, kinds[i], seg, rho)
             continue
         steps = max(1, int(math.ceil(driven(kinds[i], seg) / spacing - 1e-12)))
         for j in range(1, steps + 1):
@@ -146,6 +145,11 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
             k += 1
         x, y, th = advance(x, y, th, kinds[i], seg, rho)
     return out
+
+
+@njit(cache=True, inline="always")
+def _sampled(kind: int, seg: float) -> bool:
+    return seg != 0.0 and (kind == TURN or abs(seg) > 1e-6)
 
 
 @njit(cache=True, inline="always")

@@ -2,10 +2,14 @@
 
 RRT*'s rewiring only chooses among poses it has sampled, so after a second its best path is
 still 2–3 % longer than the best known (benchmarks/results/planner.md). Moving the path's own
-poses closes much of that: coordinate descent on each inner pose (x, y, θ), with steps that
-halve every round, takes a move when the two steered edges it changes are shorter together and
-free by the exact motion check. Start and end stay put. Static worlds only: with moving
-obstacles a shorter edge changes every later arrival time, which the kernel's rewiring handles.
+poses closes most of that. Each pass splits every edge at its middle (more poses to move: a
+chain of steered edges can hug an obstacle), then runs coordinate descent on the poses (x, y, θ)
+with steps that halve every round — a move is taken when the steered edges it changes are
+shorter together and free by the exact motion check — then drops every pose the path can skip.
+The start stays put; the end pose moves within the goal region, where the tree's first goal
+node is seldom the best place to arrive (on open_field alone that was 1 % of the length).
+Static worlds only: with moving obstacles a shorter edge changes every later arrival time,
+which the kernel's rewiring handles.
 """
 
 from __future__ import annotations
@@ -15,18 +19,31 @@ import math
 import numpy as np
 
 from planner._jit import njit
-from planner._paths import wrap_angle
+from planner._paths import pose_at, wrap_angle
 from planner._steer import state, steer_length, steer_path
 from planner._world import World, motion_free
 
-ROUNDS = 8  # step halvings: from a quarter of the mean edge to 1/1000 of it
+PASSES = 2  # split, descend, prune
+ROUNDS = 6  # step halvings per descent: from a quarter of the mean edge to 1/1000 of it
 MOVES = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0],
                   [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
 
 
 @njit(cache=True, inline="always")
+def in_goal(x: float, y: float, th: float, goal: np.ndarray) -> bool:
+    """Whether a pose is in the goal region ``goal`` = (x, y, θ, position tol, heading tol)."""
+    return (math.hypot(x - goal[0], y - goal[1]) <= goal[3]
+            and abs(wrap_angle(th - goal[2])) <= goal[4])
+
+
+@njit(cache=True, inline="always")
 def _state(q, rho):
     return state(q[0], q[1], q[2], math.cos(q[2]), math.sin(q[2]), rho)
+
+
+@njit(cache=True, inline="always")
+def _length(code: int, a, b, rho: float, bound: float) -> float:
+    return steer_length(code, _state(a, rho), _state(b, rho), rho, bound)
 
 
 @njit(cache=True)
@@ -36,37 +53,108 @@ def _free(w: World, code: int, a, b, rho: float, speed: float, kinds, lens, coun
 
 
 @njit(cache=True)
-def polish_path(w: World, code: int, rho: float, speed: float, poses: np.ndarray, kinds, lens,
-                counter) -> float:
-    """Shorten the path through ``poses`` ((n, 3), changed in place) and return its length."""
+def polish_path(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
+                goal: np.ndarray, kinds, lens, counter):
+    """The path through ``poses`` ((n, 3)) shortened: (new poses, their length)."""
+    for _ in range(PASSES):
+        poses = _split(code, rho, poses, kinds, lens)
+        _descend(w, code, rho, speed, poses, goal, kinds, lens, counter)
+        poses = _prune(w, code, rho, speed, poses, kinds, lens, counter)
+    total = 0.0
+    for i in range(poses.shape[0] - 1):
+        total += _length(code, poses[i], poses[i + 1], rho, math.inf)
+    return poses, total
+
+
+@njit(cache=True)
+def _split(code: int, rho: float, poses: np.ndarray, kinds, lens) -> np.ndarray:
+    """Every edge cut in two at the pose halfway along it (the path itself is unchanged)."""
     n = poses.shape[0]
+    out = np.empty((2 * n - 1, 3))
+    for i in range(n - 1):
+        a, b = poses[i], poses[i + 1]
+        half = 0.5 * steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], rho, kinds, lens)
+        x, y, th, _, _ = pose_at(a[0], a[1], a[2], kinds, lens, rho, half)
+        out[2 * i, :] = a
+        out[2 * i + 1, 0] = x
+        out[2 * i + 1, 1] = y
+        out[2 * i + 1, 2] = wrap_angle(th)
+    out[2 * n - 2, :] = poses[n - 1]
+    return out
+
+
+@njit(cache=True)
+def _descend(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
+             goal: np.ndarray, kinds, lens, counter) -> None:
+    """Coordinate descent on the inner poses and the end pose (within the goal), in place:
+    each round moves every pose by the step that shortens its edges most and is free."""
+    n = poses.shape[0]
+    nm = MOVES.shape[0]
     edge = np.empty(n - 1)
     for i in range(n - 1):
-        edge[i] = steer_length(code, _state(poses[i], rho), _state(poses[i + 1], rho), rho,
-                               math.inf)
+        edge[i] = _length(code, poses[i], poses[i + 1], rho, math.inf)
     step_xy = 0.25 * edge.mean()
     step_th = 0.25
-    cand = np.empty(3)
+    cand = np.empty((nm, 3))
+    gain = np.empty(nm)
+    new_a = np.empty(nm)
+    new_b = np.empty(nm)
     for _ in range(ROUNDS):
-        for i in range(1, n - 1):
-            for m in range(MOVES.shape[0]):
-                cand[0] = poses[i, 0] + MOVES[m, 0] * step_xy
-                cand[1] = poses[i, 1] + MOVES[m, 1] * step_xy
-                cand[2] = wrap_angle(poses[i, 2] + MOVES[m, 2] * step_th)
-                now = edge[i - 1] + edge[i]
-                mid = _state(cand, rho)
-                a = steer_length(code, _state(poses[i - 1], rho), mid, rho, now)
-                if a >= now - 1e-9:
+        for i in range(1, n):
+            last = i == n - 1
+            now = edge[i - 1] + (0.0 if last else edge[i])
+            for m in range(nm):
+                cand[m, 0] = poses[i, 0] + MOVES[m, 0] * step_xy
+                cand[m, 1] = poses[i, 1] + MOVES[m, 1] * step_xy
+                cand[m, 2] = wrap_angle(poses[i, 2] + MOVES[m, 2] * step_th)
+                gain[m] = 0.0
+                if last and not in_goal(cand[m, 0], cand[m, 1], cand[m, 2], goal):
                     continue
-                b = steer_length(code, mid, _state(poses[i + 1], rho), rho, now - a)
-                if a + b >= now - 1e-9:
+                a = _length(code, poses[i - 1], cand[m], rho, now)
+                b = 0.0 if last else _length(code, cand[m], poses[i + 1], rho, now - a)
+                new_a[m], new_b[m] = a, b
+                gain[m] = max(now - a - b, 0.0)
+            for m in np.argsort(-gain):
+                if gain[m] <= 1e-9:
+                    break
+                if not _free(w, code, poses[i - 1], cand[m], rho, speed, kinds, lens, counter):
                     continue
-                if not (_free(w, code, poses[i - 1], cand, rho, speed, kinds, lens, counter)
-                        and _free(w, code, cand, poses[i + 1], rho, speed, kinds, lens,
-                                  counter)):
+                if not last and not _free(w, code, cand[m], poses[i + 1], rho, speed, kinds,
+                                          lens, counter):
                     continue
-                poses[i, :] = cand
-                edge[i - 1], edge[i] = a, b
+                poses[i, :] = cand[m]
+                edge[i - 1] = new_a[m]
+                if not last:
+                    edge[i] = new_b[m]
+                break
         step_xy *= 0.5
         step_th *= 0.5
-    return edge.sum()
+
+
+@njit(cache=True)
+def _prune(w: World, code: int, rho: float, speed: float, poses: np.ndarray, kinds, lens,
+           counter) -> np.ndarray:
+    """The poses the path can skip dropped: from each kept pose, straight on to the farthest
+    later pose that one free steered edge reaches more shortly than the poses between."""
+    n = poses.shape[0]
+    along = np.zeros(n)  # driven length from the start to each pose
+    for i in range(n - 1):
+        along[i + 1] = along[i] + _length(code, poses[i], poses[i + 1], rho, math.inf)
+    keep = np.zeros(n, np.int64)
+    kept = 1
+    i = 0
+    while i < n - 1:
+        nxt = i + 1
+        for j in range(n - 1, i + 1, -1):
+            via = along[j] - along[i]
+            if (_length(code, poses[i], poses[j], rho, via) < via - 1e-9
+                    and _free(w, code, poses[i], poses[j], rho, speed, kinds, lens, counter)):
+                nxt = j
+                break
+        keep[kept] = nxt
+        kept += 1
+        i = nxt
+    out = np.empty((kept, 3))
+    for k in range(kept):
+        out[k, :] = poses[keep[k]]
+    return out

@@ -235,10 +235,11 @@ def arc_mismatch(path) -> float:
     return worst
 
 
-def schedule_errors(path, max_speed: float) -> list[str]:
+def schedule_errors(path, max_speed: float, rounding: float = 0.0) -> list[str]:
     """FORMAT.md v1.3's rules for a timed path of ``timing: optimal``: t from 0 and
-    non-decreasing, at most ``max_speed`` between entries (1 % tolerance), entries at most
-    0.05 m and 0.1 s apart. Returns one message per kind of breach."""
+    non-decreasing, at most ``max_speed`` between entries (1 % tolerance, and ``rounding`` m
+    for rows rounded to that many metres and seconds), entries at most 0.05 m and 0.1 s apart.
+    Returns one message per kind of breach."""
     path = np.asarray(path, dtype=float)
     step = np.hypot(*np.diff(path[:, :2], axis=0).T)
     dt = np.diff(path[:, 3])
@@ -248,7 +249,7 @@ def schedule_errors(path, max_speed: float) -> list[str]:
     if (dt < 0).any():
         errors.append(f"t decreases after entry {int(np.argmax(dt < 0))}")
     moving = step > 1e-9
-    fast = moving & (step > 1.01 * max_speed * np.maximum(dt, 0.0))
+    fast = moving & (step > 1.01 * max_speed * np.maximum(dt, 0.0) + 2 * rounding)
     if fast.any():
         k = int(np.argmax(fast))
         errors.append(f"entry {k} to {k + 1}: {step[k]:.4f} m in {dt[k]:.4f} s is above "

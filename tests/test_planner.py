@@ -236,3 +236,21 @@ def test_a_safety_margin_is_kept_from_every_obstacle_and_wall():
     scn["vehicle"]["safety_margin"] = 5.0
     with pytest.raises(planner.ScenarioError, match="with the safety margin of 5 m"):
         planner.compile_problem(planner.parse_scenario(scn))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_polishing_finds_where_to_enter_the_goal_region(seed):
+    """Start (1, 1, 0), goal (11, 1, 0) ± 0.25 m and 20°, nothing in the way: the shortest
+    path drives straight on and stops where it enters the goal disc, after 10 − 0.25 m — not
+    at whatever goal pose the tree sampled."""
+    scn = {"name": "goal entry", "bounds": [0, 0, 12, 3],
+           "vehicle": {"wheelbase": 0.44, "max_steer_deg": 26.0, "radius": 0.0},
+           "start": [1.0, 1.0, 0.0], "goal": [11.0, 1.0, 0.0],
+           "goal_tolerance": {"position": 0.25, "heading_deg": 20.0}, "obstacles": []}
+    result = planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=3000,
+                           seed=seed)
+    assert result.cost == pytest.approx(9.75, rel=1e-3)  # the last step: 1/128 of an edge
+    assert math.hypot(result.path[-1, 0] - 11.0, result.path[-1, 1] - 1.0) <= 0.25 + 1e-12
+    unpolished = planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=3000,
+                               seed=seed, polish=False)
+    assert unpolished.cost > result.cost + 0.01
