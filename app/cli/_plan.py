@@ -40,7 +40,6 @@ def plan(
     import planner as core
     from app.animate import FRAMES, FrameRecorder, check_animation_path, title, write_animation
     from app.planning import run_plan
-    from app.raceline import path_raceline, raceline_limits
 
     with user_errors():
         if animate is not None:
@@ -54,6 +53,8 @@ def plan(
             write_animation(recorder.frames, recorder.problem,
                             title(report.scenario, options), animate)
         if raceline is not None and report.solved:
+            from app.raceline import path_raceline, raceline_limits  # loads the tracks package
+
             limits = raceline_limits(vehicle=scenario_model.vehicle)
             raceline.write_text(path_raceline(report.path, limits))
         elif raceline is not None:
