@@ -16,7 +16,7 @@ import planner
 from app.raceline import raceline_limits
 from app.studio._compare import Pins, Run
 from app.studio._live_view import PATH_RGB, LiveView
-from app.studio._plots import Profiles
+from app.studio._plots import SHADE, Profiles
 from app.studio._scene import REVERSE_RGB, Z, arc_length, marker_size
 from app.studio._tree import SEG
 from app.studio._worker import PlannerWorker
@@ -118,8 +118,9 @@ def test_the_profiles_shade_the_reverse_stretches_and_mark_the_cusps(parked, ser
         # The piece from row i to i + 1 spans s[i]..s[i + 1], in the direction of row i + 1.
         on = (s[:-1, None] <= grid) & (grid <= s[1:, None])  # (piece, grid point)
         back, ahead = (on & (path[1:, 4:5] < 0)).any(0), (on & (path[1:, 4:5] > 0)).any(0)
-        assert np.isfinite(shade[back]).all() and back.any()
-        assert np.isnan(shade[ahead & ~back][1:]).all()  # the first: uPlot's (`_for_uplot`)
+        top = chart.data[3][0] * SHADE  # +κmax, +δmax
+        assert back.any() and np.allclose(shade[back], top)  # filled down to −top
+        assert np.allclose(shade[ahead & ~back], -top)  # a fill of no height
 
 
 def test_a_click_on_an_edge_names_its_word_and_length(parked, server):
@@ -143,6 +144,6 @@ def test_a_click_on_an_edge_names_its_word_and_length(parked, server):
     away = [n for n in range(1, live.chunks.count) if n not in nodes and np.min(np.hypot(
         *(live.best_path[:, None, :2] - live.chunks.get(n)[SEG // 2]).T)) > 1.0]
     assert "· tree edge into node " in view.pick(*live.chunks.get(away[0])[SEG // 2])
-    xmin, ymin, xmax, ymax = problem.bounds
+    *_, xmax, ymax = problem.bounds
     assert view.pick(xmax + 5.0, ymax + 5.0) is None
     assert not view._handles["pick"].visible and not view._handles["pick_l"].visible

@@ -109,9 +109,16 @@ def _reverse_on(grid: np.ndarray, path: np.ndarray) -> np.ndarray:
     return (sides[0] | sides[1]) & (grid <= s[-1])
 
 
+def _shade(rev: np.ndarray, limit: float) -> np.ndarray:
+    """The reverse shading's line: at the top where the path reverses, else at the bottom,
+    where its fill (down to the bottom) has no height. uPlot fills across gaps (NaN), so
+    the stretches cannot be cut out of the line."""
+    return np.where(rev, SHADE * limit, -SHADE * limit)
+
+
 def _reverse_series(limit: float) -> tuple[dict, dict]:
-    """The reverse shading (a fill from +limit down to −limit under reverse stretches) and
-    the cusps (points on the zero line), as uPlot series."""
+    """The reverse shading (a fill from +limit down to −limit under reverse stretches, see
+    `_shade`) and the cusps (points on the zero line), as uPlot series."""
     shade = _series("reverse (shaded)", "rgba(0,0,0,0)", 0) | {
         "fill": "rgba(110,110,130,0.22)", "fillTo": -SHADE * limit}
     cusp = _series("cusp ◆", "rgba(0,0,0,0)", 0) | {
@@ -183,10 +190,10 @@ class Profiles:
         marks = np.full(len(grid), math.nan)
         marks[list(self._cusps)] = 0.0
         kappa = (grid, centre, pk, self._kmax * one, -self._kmax * one,
-                 np.where(rev, SHADE * self._kmax, math.nan), marks, *pins)
+                 _shade(rev, self._kmax), marks, *pins)
         steer = (grid, _steer_deg(centre, self._wb), _steer_deg(pk, self._wb),
                  self._dmax * one, -self._dmax * one,
-                 np.where(rev, SHADE * self._dmax, math.nan), marks,
+                 _shade(rev, self._dmax), marks,
                  *(_steer_deg(k, r.wheelbase) for k, r in zip(pins, self._pins)))
         return kappa, steer, self._speed(grid, path)
 

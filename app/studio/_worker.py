@@ -177,7 +177,7 @@ class PlannerWorker:
 
     # -- the listener (planner thread) ---------------------------------------------------------
     def _on_events(self, ev: planner.TreeEvents | None) -> None:
-        tree, live = self._tree, self.live
+        live = self.live
         if ev is None:
             self._record(0)
             return
