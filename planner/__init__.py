@@ -17,6 +17,7 @@ import os
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from planner._paths import path_length, path_word
     from planner.options import PlanOptions
     from planner.problem import Problem, compile_problem
     from planner.rrt import Planner, Result
@@ -41,13 +42,14 @@ _HOMES = {
     "Scenario": "scenario", "ScenarioError": "scenario", "bundled_scenario_path": "scenario",
     "load_scenario": "scenario", "parse_scenario": "scenario", "scenario_names": "scenario",
     "scenario_schema": "scenario", "TimeOptimalPlanner": "timing", "planner_for": "timing",
+    "path_length": "_paths", "path_word": "_paths",
 }
 
 __all__ = [
     "STEERINGS", "PlanOptions", "Planner", "Problem", "Result", "Rewire", "Scenario",
     "ScenarioError", "TimeOptimalPlanner", "TreeEvents", "TreeSnapshot", "bundled_scenario_path",
-    "compile_problem", "load_scenario", "parse_scenario", "planner_for", "scenario_names",
-    "scenario_schema", "solve",
+    "compile_problem", "load_scenario", "parse_scenario", "path_length", "path_word",
+    "planner_for", "scenario_names", "scenario_schema", "solve",
 ]
 
 

@@ -23,6 +23,27 @@ from planner._jit import njit
 MAX_SEGMENTS = 5
 LEFT, STRAIGHT, RIGHT, TURN = 1, 0, -1, 2
 _TWO_PI = 2.0 * math.pi
+_LETTERS = {LEFT: "L", STRAIGHT: "S", RIGHT: "R", TURN: "T"}
+
+
+def path_word(kinds, lens) -> str:
+    """The path's steering word, one letter per segment in driving order: L left arc, S
+    straight, R right arc, T turn on the spot ("LSL", "RSR", "TST"); unused segments are left
+    out. A path that reverses anywhere gives each driven segment its direction, + forward and
+    − reverse, as Reeds and Shepp write their words ("L+R−S−"): a forward-only word stays short,
+    the way Dubins words are known. A turn on the spot drives no way and has no direction. The
+    empty path (the root's) has the empty word.
+
+    >>> import numpy as np
+    >>> path_word(np.array([1, 0, 1, 0, 0]), np.array([0.5, 2.0, 0.3, 0.0, 0.0]))
+    'LSL'
+    >>> path_word(np.array([1, -1, 0, 0, 0]), np.array([0.4, -0.9, -1.0, 0.0, 0.0]))
+    'L+R−S−'
+    """
+    segs = [(int(k), float(v)) for k, v in zip(kinds, lens) if v != 0.0]
+    reverses = any(v < 0.0 and k != TURN for k, v in segs)
+    return "".join(_LETTERS[k] + ("" if not reverses or k == TURN else "+" if v > 0 else "−")
+                   for k, v in segs)
 
 
 @njit(cache=True, inline="always")

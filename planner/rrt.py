@@ -182,6 +182,12 @@ class Planner:
         t = self._tree
         return edge_points(t.pose, t.parent, t.kinds, t.lens, self.problem.rho, node, count)
 
+    def edge_segments(self, node: int) -> tuple[np.ndarray, np.ndarray]:
+        """The local path from ``node``'s parent to it in segment form: kinds and signed
+        lengths (`planner.path_word` names it, `planner.path_length` measures it); copies, of
+        the live tree, so read on the planner's thread like `poses`."""
+        return self._tree.kinds[node].copy(), self._tree.lens[node].copy()
+
     def steer_points(self, a, b, count: int = 4) -> np.ndarray:
         """(count + 1, 2) positions along this planner's steering from pose a to pose b: a
         motion the tree does not hold, such as a Steer that an obstacle blocked."""

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from planner._paths import path_end, path_length, pose_at, sample_path
+from planner._paths import path_end, path_length, path_word, pose_at, sample_path
 
 lengths = st.floats(-5, 5, allow_nan=False)
 kinds_st = st.lists(st.sampled_from([-1, 0, 1]), min_size=5, max_size=5)
@@ -31,3 +31,52 @@ def test_samples_are_continuous_and_end_at_the_end(kinds, lens, rho):
     assert np.all(np.hypot(*np.diff(pts[:, :2], axis=0).T) <= 0.02 + 1e-9)
     mid = pose_at(0.5, -0.2, 0.3, kinds, lens, rho, path_length(kinds, lens))
     assert np.allclose(mid[:3], end, atol=1e-9)
+
+
+def _word(steering: str, goal, rho: float = 1.0) -> str:
+    from planner._steer import steer_path
+    from planner.steering import STEERINGS
+
+    kinds, lens = np.zeros(5, np.int8), np.zeros(5)
+    steer_path(STEERINGS[steering].code, 0.0, 0.0, 0.0, *map(float, goal), rho, kinds, lens)
+    return path_word(kinds, lens)
+
+
+@pytest.mark.parametrize("goal, word", [
+    ((5, 0, 0), "S"),  # LSL with both arcs 0: unused segments are left out
+    ((5, 3, 0), "LSR"), ((5, -3, 0), "RSL"),  # a lane change to the left, to the right
+    ((0, 5, math.pi), "LSL"), ((0, -5, math.pi), "RSR"),  # wide U-turns
+    ((0.3, 0, math.pi), "LRL"),  # facing back close by: three arcs
+])
+def test_dubins_words_of_known_motions(goal, word):
+    assert _word("dubins", goal) == word
+
+
+@pytest.mark.parametrize("goal, word", [
+    ((-3, 0, 0), "S−"),  # straight back
+    ((5, 3, 0), "LSR"),  # no reversing: the Dubins word, unsigned
+    ((0.3, 0, math.pi), "L+R−L+"),  # a three-point turn
+    ((0, 0.5, 0), "R+L−R−L+"),  # parallel parking: a cusp on each side of the reverse
+])
+def test_reeds_shepp_words_mark_each_segments_direction_once_it_reverses(goal, word):
+    assert _word("reeds-shepp", goal) == word
+
+
+def test_a_turn_on_the_spot_is_t_without_a_direction():
+    assert _word("straight", (5, 3, 0)) == "TST"
+    assert path_word(np.array([2, 0, 0, 0, 0]), np.array([1.0, -2.0, 0, 0, 0])) == "TS−"
+    assert path_word(np.zeros(5, np.int8), np.zeros(5)) == ""  # the root's edge
+
+
+@settings(max_examples=100, deadline=None)
+@given(kinds_st, st.lists(lengths, min_size=5, max_size=5))
+def test_the_word_names_the_segments_a_path_samples(kinds, lens):
+    """One letter per segment that moves, and where a sign is written it is the driving
+    direction `sample_path` gives that segment's poses."""
+    kinds, lens = np.array(kinds, dtype=np.int8), np.array(lens)
+    word = path_word(kinds, lens)
+    letters = [c for c in word if c in "LSR"]
+    assert letters == ["LSR"[1 - k] for k, v in zip(kinds, lens) if v != 0.0]
+    signs = [c for c in word if c in "+−"]
+    rows = sample_path(0.0, 0.0, 0.0, kinds, lens, 1.0, 10.0)[1:, 4]  # a row per segment
+    assert signs == ([] if (rows > 0).all() else ["+" if d > 0 else "−" for d in rows])

@@ -468,7 +468,7 @@ def test_pinned_runs_keep_their_colours_and_the_comparison_has_a_row_and_curves_
                                 add_line_segments=lambda name, seg, rgb, **k: drawn.append(rgb)))
     for run in (rrt, star, rrt, star, rrt):
         pins.add(run)
-    pins.draw()
+    pins.draw(0.1)
     assert [p.name for p in pins.runs] == ["pin 2", "pin 3", "pin 4", "pin 5"]
     assert len(drawn) == MAX_PINS and pins.runs[-1].colour == PALETTE[0]  # pin 1's
     assert {p.colour for p in pins.runs} == set(PALETTE)
@@ -492,7 +492,8 @@ def test_pinned_runs_keep_their_colours_and_the_comparison_has_a_row_and_curves_
 
     charts = []
     gui = SimpleNamespace(add_uplot=lambda data, series, **k: charts.append(
-        SimpleNamespace(data=data, series=series)) or charts[-1])
+        SimpleNamespace(data=data, series=series)) or charts[-1],
+                          add_markdown=lambda content: SimpleNamespace(content=content))
     profiles = Profiles(gui, np.linspace(0, 14, 50), np.zeros(50), 10.0, 0.44, 26.0,
                         raceline_limits(vehicle=problem.scenario.vehicle))
     profiles.show_path(star.path)

@@ -19,10 +19,10 @@ import numpy as np
 import planner
 from app.studio._live_view import PATH_RGB
 from app.studio._panel import PLANNERS, TIMINGS
-from app.studio._scene import Z, polyline_segments
+from app.studio._scene import Z, arc_length, path_layers
 
-__all__ = ["CURRENT", "MAX_PINS", "PALETTE", "Pins", "Run", "arc_length", "comparison_csv",
-           "comparison_png", "cost_curves"]
+__all__ = ["CURRENT", "MAX_PINS", "PALETTE", "Pins", "Run", "comparison_csv", "comparison_png",
+           "cost_curves"]
 
 # Violet, teal, sienna, olive: none is a colour another line in the scene has (the tree's
 # blue, the path's pink, the rewire flashes' red and green, the centreline's blue, yellow and
@@ -35,11 +35,6 @@ COLUMNS = ("run", "colour", "planner", "steering", "seed", "timing", "iterations
            "max_abs_curvature_per_m", "waited_s")
 _PLANNER_LABELS = {v: k for k, v in PLANNERS.items()}
 _TIMING_LABELS = {v: k for k, v in TIMINGS.items()}
-
-
-def arc_length(path: np.ndarray) -> np.ndarray:
-    """The distance driven to each row of a path (x, y in its first columns)."""
-    return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path[:, :2], axis=0).T))])
 
 
 @dataclass(frozen=True)
@@ -135,18 +130,22 @@ class Pins:
     def clear(self) -> None:
         self.runs, self._pinned = [], 0
 
-    def draw(self, scale: float = 1.0) -> None:
+    def draw(self, marker: float, scale: float = 1.0) -> None:
         """The pinned paths, anew (also into a fresh scene, where the old ones are gone), lines
-        ``scale`` times as wide (projector mode): one line node per pin, since per-vertex
-        colours would be drawn paler than the legend's."""
+        ``scale`` times as wide (projector mode), reverse stretches and cusps marked as the
+        current run's are (`path_layers`, cusps ``marker`` wide): line nodes per pin, since
+        per-vertex colours would be drawn paler than the legend's."""
         self.scene.remove_by_name("/pins")
         if not self.runs:
             return
         self.scene.add_frame("/pins", show_axes=False)
         for i, run in enumerate(self.runs):
-            self.scene.add_line_segments(
-                f"/pins/{i}", polyline_segments(run.path[:, :2], Z["pin"]), _rgb(run.colour),
-                thickness=3.0 * scale, thickness_units="screen")
+            for suffix, seg, rgb, px in path_layers(run.path, _rgb(run.colour), marker,
+                                                    Z["pin"]):
+                if len(seg):
+                    self.scene.add_line_segments(f"/pins/{i}{suffix}", seg, rgb,
+                                                 thickness=0.75 * px * scale,
+                                                 thickness_units="screen")
 
     def legend_html(self) -> str:
         """Each pin's colour, settings and result, then the current run's colour."""

@@ -15,7 +15,7 @@ import re
 import numpy as np
 
 from app.studio._gizmo import gizmo
-from app.studio._scene import DRAFT_RGB, Z, obstacle_shape, polyline_segments
+from app.studio._scene import DRAFT_RGB, Z, ground_point, obstacle_shape, polyline_segments
 
 __all__ = ["Editor", "moved_obstacle", "nearest_s", "parse_waypoints"]
 
@@ -167,17 +167,19 @@ class Editor:
             other.value = False  # runs this again, which settles the mode
             return
         self._click_mode = "track" if u.draw.value else "polygon" if u.polygon.value else None
-        self.scene.remove_click_callback("all")
+        self.scene.remove_click_callback(self._ground_click)  # not the session's edge clicks
         if self._click_mode is not None:
             self.scene.on_click()(self._ground_click)
 
+    @property
+    def clicking(self) -> bool:
+        """Whether ground clicks draw (track points or polygon corners) just now."""
+        return self._click_mode is not None
+
     def _ground_click(self, ev) -> None:
-        """Where the click ray meets the ground plane z = 0."""
-        (ox, oy, oz), (dx, dy, dz) = ev.ray_origin, ev.ray_direction
-        if abs(dz) < 1e-12 or -oz / dz < 0:
+        p = ground_point(ev)
+        if p is None:
             return
-        t = -oz / dz
-        p = (ox + t * dx, oy + t * dy)
         if self._click_mode == "polygon":
             self._polygon.append(p)
             self._show_polygon()

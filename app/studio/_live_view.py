@@ -14,20 +14,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
+import planner
 from app.studio._scene import (
     CURVATURE_RGB,
+    CUSP_UNDER_RGB,
     GOAL_RGB,
     MOVER_RGB,
     OBSTACLE_RGB,
+    REVERSE_RGB,
     START_RGB,
     Z,
     marker_size,
     metres_per_px,
+    path_layers,
     polyline_segments,
 )
 from app.studio._worker import FLASH_S, Live
 
-__all__ = ["LEGEND", "LiveView", "Look", "legend_html", "place_labels", "step_labels"]
+__all__ = ["LEGEND", "LiveView", "Look", "edge_label", "legend_html", "place_labels",
+           "step_labels"]
 
 TREE_RGB = (70, 150, 235)
 TREE_FADED_RGB = (90, 98, 118)  # near the asphalt: the path and the step overlay stand out
@@ -38,6 +43,8 @@ REWIRE_OLD_RGB, REWIRE_NEW_RGB = (255, 160, 60), (80, 255, 220)
 BLOCKED_RGB = (255, 40, 40)
 LEGEND = (  # (what, colour or colours, drawn as a line, a ring or a filled shape)
     ("tree", TREE_RGB, "line"), ("best path", PATH_RGB, "line"),
+    ("reverse: driven backwards", (PATH_RGB, REVERSE_RGB), "dash"),
+    ("cusp: stops, changes direction", (REVERSE_RGB, CUSP_UNDER_RGB), "diamond"),
     ("x_rand, the sample", RAND_RGB, "ring"), ("x_nearest", NEAREST_RGB, "ring"),
     ("x_new, its edge from x_min", NEW_RGB, "ring"), ("near set, radius r(n)", NEAR_RGB, "ring"),
     ("rewire: old edge", REWIRE_OLD_RGB, "line"), ("rewire: new edge", REWIRE_NEW_RGB, "line"),
@@ -47,6 +54,8 @@ LEGEND = (  # (what, colour or colours, drawn as a line, a ring or a filled shap
     ("centreline: straight … tightest turn", CURVATURE_RGB, "line"),
 )
 TREE_PX = 1.2
+PICK_RGB = (255, 245, 130)  # the clicked edge's halo
+PICK_PX = 10.0  # a click this near an edge (on screen, at scale 1) picks it
 SIDES = ((1, 1), (1, -1), (-1, 1), (-1, -1))  # a label's quadrant off its point (x, y)
 # A label's size on screen at scale 1 (viser: a 12 px em, padded): px per character, padding
 # and height.
@@ -78,9 +87,15 @@ def legend_html() -> str:
     def swatch(rgb, kind: str) -> str:
         paint = (f"linear-gradient(90deg,{','.join(f'rgb{c}' for c in rgb)})"
                  if isinstance(rgb[0], tuple) else f"rgb{rgb}")
-        shape = {"line": "width:18px;height:4px",
+        if kind == "dash":  # the colour's dashes on the other
+            paint = f"repeating-linear-gradient(90deg,rgb{rgb[0]} 0 4px,rgb{rgb[1]} 4px 8px)"
+        shape = {"line": "width:18px;height:4px", "dash": "width:18px;height:4px",
                  "ring": f"width:9px;height:9px;border-radius:50%;border:3px solid rgb{rgb}",
+                 "diamond": f"width:7px;height:7px;transform:rotate(45deg);"
+                            f"border:2px solid rgb{rgb[1]};margin-left:3px",
                  "fill": "width:12px;height:10px"}[kind]
+        if kind == "diamond":
+            paint = f"rgb{rgb[0]}"
         fill = "" if kind == "ring" else f";background:{paint}"
         return (f"<span style='display:inline-block;{shape}{fill};outline:1px solid #999;"
                 f"margin-right:5px;vertical-align:middle'></span>")
@@ -168,6 +183,12 @@ def step_labels(st: dict, bounds, scale: float = 1.0, m_per_px: float | None = N
     return place_labels(points, bounds, scale, m_per_px)
 
 
+def edge_label(kinds: np.ndarray, lens: np.ndarray, place: str) -> str:
+    """What a clicked edge says: its steering word, its driven length and where it is
+    ("LSL · 1.84 m · best path, edge 2 of 5")."""
+    return f"{planner.path_word(kinds, lens)} · {planner.path_length(kinds, lens):.2f} m · {place}"
+
+
 class LiveView:
     """One run's drawing in one client's scene; `clear` removes all of it."""
 
@@ -231,8 +252,9 @@ class LiveView:
             self._flashes()
         if self.live.best_version != self._seen["best"]:
             self._seen["best"] = self.live.best_version
-            path = self.live.best_path
-            self._put("best", polyline_segments(path[:, :2], Z["path"]), PATH_RGB, 4.0)
+            for suffix, seg, rgb, px in path_layers(self.live.best_path, PATH_RGB, self.marker,
+                                                    Z["path"]):
+                self._put(f"best{suffix}", seg, rgb, px)
         if self.live.step_version != self._seen["step"]:
             self._seen["step"] = self.live.step_version
             self._step_overlay(self.live.step)
@@ -289,6 +311,32 @@ class LiveView:
                                                        font_screen_scale=self.look.scale)
         else:
             h.position, h.text, h.anchor, h.visible = pos, text, anchor, True
+
+    def pick(self, x: float, y: float) -> str | None:
+        """A click on the ground at (x, y): the edge drawn there — of the best path first,
+        else of the tree — gets a halo and a label with its word (`edge_label`); a click
+        beside every edge takes them away. Returns the label's text (None: no edge)."""
+        chunks = self.live.chunks
+        view = metres_per_px(self.camera) if self.camera is not None else None
+        reach = PICK_PX * self.look.scale * (view or self.marker / MARKER_PX)
+        near = chunks.distances((x, y))
+        words = [(int(i), *chunks.edge(int(i))) for i in np.flatnonzero(near <= reach)]
+        words = [w for w in words if np.any(w[2] != 0.0)]  # the root has no edge
+        best = list(self.live.best_nodes)
+        on_best = [w for w in words if w[0] in best]
+        if not (on_best or words):
+            for name in ("pick", "pick_l"):
+                if name in self._handles:
+                    self._handles[name].visible = False
+            return None
+        node, kinds, lens = min(on_best or words, key=lambda w: near[w[0]])
+        place = (f"best path, edge {best.index(node)} of {len(best) - 1}" if on_best
+                 else f"tree edge into node {node}")
+        text = edge_label(kinds, lens, place)
+        self._put("pick", polyline_segments(chunks.get(node), Z["path"] - 1e-4), PICK_RGB,
+                  PICK_PX)
+        self._label("pick_l", text, (x, y), "bottom-left")
+        return text
 
     def clear(self) -> None:
         for h in [*self._chunks.values(), *self._handles.values()]:

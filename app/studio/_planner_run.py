@@ -106,6 +106,7 @@ class PlannerRun:
         self.ui.metrics.content = "—"
         self.ui.extend.content = render(None, FIRST_NOTE)
         if self._profiles is not None:
+            self._profiles.set_steering(options.steering)
             self._profiles.show_path(np.zeros((0, 4)))
             self._profiles.show_cost(self.current())
 
@@ -133,7 +134,7 @@ class PlannerRun:
         self.look = look
         if self._view is not None:
             self._view.restyle(look)
-        self.pins.draw(look.scale)
+        self._draw_pins()
 
     def raceline(self) -> str | None:
         """The best path in the TUM raceline layout within the scenario vehicle's limits (None
@@ -142,6 +143,11 @@ class PlannerRun:
         if path is None or not len(path):
             return None
         return path_raceline(path, raceline_limits(vehicle=self.stage.parsed.vehicle))
+
+    def pick(self, x: float, y: float) -> None:
+        """A click on the ground at (x, y): the edge there says its word (`LiveView.pick`)."""
+        if self._view is not None:
+            self._view.pick(x, y)
 
     # -- compare runs --------------------------------------------------------------------------
     def current(self) -> Run | None:
@@ -174,8 +180,14 @@ class PlannerRun:
         self.pins.clear()
         self._show_pins()
 
+    def _draw_pins(self) -> None:
+        """The pins with cusps sized like the scene's markers (pins exist only once a problem
+        was planned: before, there is nothing to size)."""
+        marker = marker_size(self.stage.problem.bounds) if self.pins.runs else 0.0
+        self.pins.draw(marker, self.look.scale)
+
     def _show_pins(self) -> None:
-        self.pins.draw(self.look.scale)
+        self._draw_pins()
         self.ui.pins_legend.content = self.pins.legend_html()
         self.ui.pins_legend.visible = bool(self.pins.runs)
         self._profiles.set_pins(self.pins.runs)

@@ -4,6 +4,10 @@ its speed limit and lateral and longitudinal accelerations (`tracks.path_rows`, 
 profile), under the shaded envelope min(v_max, √(a_lat/|κ|)); and the best cost over planning
 time.
 
+The current run's reverse stretches are shaded in the curvature and steering plots and its cusps
+marked on the zero line; a caption says in plain words what the steering's curvature looks
+like (Dubins: the bang-bang of arcs and straights).
+
 The x axis is shared arc length, so the centreline is cut to the stretch from the start to the
 goal — the part of the track the path is meant to follow. Pinned runs (_compare.py) add their
 curvature, steering and cost curves in their colours; the current run is the best path's pink.
@@ -16,7 +20,8 @@ import math
 import numpy as np
 
 import tracks
-from app.studio._compare import CURRENT, arc_length, cost_curves
+from app.studio._compare import CURRENT, cost_curves
+from app.studio._scene import arc_length, cusp_rows, reversing
 
 __all__ = ["Profiles"]
 
@@ -80,6 +85,46 @@ def _series(label: str, stroke: str | None = None, width: float = 1.5, dash=None
 
 # Arc length and seconds are plain numbers: uPlot's x axis would otherwise show dates.
 NUMERIC_X = {"x": {"time": False}}
+SHADE = 1.15  # the reverse shading reaches this times the limit, above and below
+CAPTIONS = {  # what the path's curvature looks like, per steering
+    "dubins": "Dubins paths are arcs at the tightest turn and straights: the path's κ is "
+              "+1/ρ, −1/ρ or 0 and jumps between them (bang-bang), never in between; "
+              "±κmax = 1/ρ.",
+    "reeds-shepp": "Reeds-Shepp paths are arcs at the tightest turn and straights, forward or "
+                   "in reverse: κ is ±1/ρ or 0 (bang-bang). Shaded: driven in reverse; "
+                   "◆ on the zero line: a cusp, where the car stops and changes direction.",
+    "straight": "Straight lines: κ = 0 all along; the robot turns on the spot between them.",
+}
+
+
+def _reverse_on(grid: np.ndarray, path: np.ndarray) -> np.ndarray:
+    """Whether the path is driven in reverse at each grid point: on a reverse piece, or at
+    either end of one (a cusp's point belongs to both sides)."""
+    rev = reversing(path)
+    if not rev.any():
+        return np.zeros(len(grid), bool)
+    s = arc_length(path)
+    sides = [rev[(np.searchsorted(s, grid, side) - 1).clip(0, len(rev) - 1)]
+             for side in ("left", "right")]
+    return (sides[0] | sides[1]) & (grid <= s[-1])
+
+
+def _shade(rev: np.ndarray, limit: float) -> np.ndarray:
+    """The reverse shading's line: at the top where the path reverses, else at the bottom,
+    where its fill (down to the bottom) has no height. uPlot fills across gaps (NaN), so
+    the stretches cannot be cut out of the line."""
+    return np.where(rev, SHADE * limit, -SHADE * limit)
+
+
+def _reverse_series(limit: float) -> tuple[dict, dict]:
+    """The reverse shading (a fill from +limit down to −limit under reverse stretches, see
+    `_shade`) and the cusps (points on the zero line), as uPlot series."""
+    shade = _series("reverse (shaded)", "rgba(0,0,0,0)", 0) | {
+        "fill": "rgba(110,110,130,0.22)", "fillTo": -SHADE * limit}
+    cusp = _series("cusp ◆", "rgba(0,0,0,0)", 0) | {
+        "points": {"show": True, "size": 9, "width": 2, "stroke": "#222", "fill": "#fff",
+                   "filter": ()}}
+    return shade, cusp
 
 
 class Profiles:
@@ -95,17 +140,19 @@ class Profiles:
         self._kmax = math.tan(math.radians(max_steer_deg)) / wheelbase
         self._limits = limits
         band = ({"series": (3, 4), "fill": "rgba(80,200,120,0.12)"},)
+        self._cusps: tuple = ()  # the grid indices of the current path's cusps
         kappa, steer, speed = map(_for_uplot, self._profiles(np.zeros((0, 4))))
         common = {"aspect": 1.6, "bands": band, "legend": {"show": True}, "scales": NUMERIC_X}
+        self.caption = gui.add_markdown(CAPTIONS["dubins"])
         self.curvature = gui.add_uplot(
             kappa, (_series("s (m)"), _series("centreline κ", "#4a90e2"),
                     _series("path κ", CURRENT, 2.0), _series("+κmax", "#2e9e5b", 1, [4, 4]),
-                    _series("−κmax", "#2e9e5b", 1, [4, 4])),
+                    _series("−κmax", "#2e9e5b", 1, [4, 4]), *_reverse_series(self._kmax)),
             title="Curvature κ (1/m) vs s", **common)
         self.steering = gui.add_uplot(
             steer, (_series("s (m)"), _series("centreline δ", "#4a90e2"),
                     _series("path δ", CURRENT, 2.0), _series("+δmax", "#2e9e5b", 1, [4, 4]),
-                    _series("−δmax", "#2e9e5b", 1, [4, 4])),
+                    _series("−δmax", "#2e9e5b", 1, [4, 4]), *_reverse_series(self._dmax)),
             title="Steering δ (deg) vs s", **common)
         self.speed = gui.add_uplot(
             speed, (_series("s (m)"), _series("path v", CURRENT, 2.0),
@@ -122,20 +169,31 @@ class Profiles:
 
     @property
     def handles(self) -> tuple:
-        return self.curvature, self.steering, self.speed, self.cost
+        return self.caption, self.curvature, self.steering, self.speed, self.cost
+
+    def set_steering(self, name: str) -> None:
+        """The caption for paths of this steering (`planner.STEERINGS`' names)."""
+        self.caption.content = CAPTIONS[name]
 
     def _profiles(self, path: np.ndarray) -> tuple[tuple, tuple, tuple]:
-        """(curvature, steering data): x, centreline, path, +max, −max, each pin on one s grid
-        as long as the longest path; (speed data): x, the path's speed, its envelope, 0."""
+        """(curvature, steering data): x, centreline, path, +max, −max, the path's reverse
+        shading and cusps, each pin on one s grid as long as the longest path (with the
+        cusps' s in it); (speed data): x, the path's speed, its envelope, 0."""
         paths = [path, *(r.path for r in self._pins)]
         end = max((arc_length(p)[-1] for p in paths if len(p) >= 2), default=self._goal_s)
-        grid = np.linspace(0.0, max(end, 1e-3), N)
+        cusps = arc_length(path)[cusp_rows(path)]
+        grid = np.union1d(np.linspace(0.0, max(end, 1e-3), N), cusps)
+        self._cusps = tuple(int(i) for i in np.searchsorted(grid, cusps))
         centre = _on_grid(grid, self._cs, self._ck)
         pk, *pins = [_along(grid, arc_length(p), p[:, 3]) for p in paths]
-        one = np.ones(N)
-        kappa = (grid, centre, pk, self._kmax * one, -self._kmax * one, *pins)
+        one, rev = np.ones(len(grid)), _reverse_on(grid, path)
+        marks = np.full(len(grid), math.nan)
+        marks[list(self._cusps)] = 0.0
+        kappa = (grid, centre, pk, self._kmax * one, -self._kmax * one,
+                 _shade(rev, self._kmax), marks, *pins)
         steer = (grid, _steer_deg(centre, self._wb), _steer_deg(pk, self._wb),
                  self._dmax * one, -self._dmax * one,
+                 _shade(rev, self._dmax), marks,
                  *(_steer_deg(k, r.wheelbase) for k, r in zip(pins, self._pins)))
         return kappa, steer, self._speed(grid, path)
 
@@ -144,18 +202,30 @@ class Profiles:
         try:
             rows = tracks.path_rows(path[:, :3], self._limits)
         except (tracks.TrackError, IndexError):  # no path yet, or a single pose
-            return grid, np.full(N, math.nan), np.full(N, math.nan), np.zeros(N)
+            return grid, *np.full((2, len(grid)), math.nan), np.zeros(len(grid))
         s, kappa, v = rows[:, 0], np.abs(rows[:, 4]), np.abs(rows[:, 5])
         cap = np.minimum(self._limits.v_max,
                          np.sqrt(self._limits.a_lat / np.maximum(kappa, 1e-300)))
-        return grid, _along(grid, s, v), _along(grid, s, cap), np.zeros(N)
+        return grid, _along(grid, s, v), _along(grid, s, cap), np.zeros(len(grid))
 
     def show_path(self, path: np.ndarray) -> None:
         self._path = path
+        cusps = self._cusps
         kappa, steer, speed = self._profiles(path)
+        if self._cusps != cusps:  # the points drawn are the cusps' (uPlot's points.filter)
+            self._show_series()
         self.curvature.data = _for_uplot(kappa)
         self.steering.data = _for_uplot(steer)
         self.speed.data = _for_uplot(speed)
+
+    def _show_series(self) -> None:
+        """Each chart's series: its own, the cusps' points where they are now, the pins'."""
+        for h, base, symbol in zip((self.curvature, self.steering, self.cost), self._series,
+                                   (" κ", " δ", "")):
+            if h is not self.cost:
+                cusp = base[6]
+                base = (*base[:6], cusp | {"points": cusp["points"] | {"filter": self._cusps}})
+            h.series = base + tuple(_series(r.name + symbol, r.colour, 1.5) for r in self._pins)
 
     def show_cost(self, current) -> None:
         """The current run's (a `_compare.Run`) best cost against planning time and the pinned
@@ -174,9 +244,7 @@ class Profiles:
         """Pinned runs (`_compare.Run`) as series of their own, named and coloured as the
         pins; the caller sends it atomically, the series with the data that matches them."""
         self._pins = list(runs)
-        for h, base, symbol in zip((self.curvature, self.steering, self.cost), self._series,
-                                   (" κ", " δ", "")):
-            h.series = base + tuple(_series(r.name + symbol, r.colour, 1.5) for r in runs)
+        self._show_series()
         self.show_path(self._path)
         if self._current is not None:
             self.show_cost(self._current)

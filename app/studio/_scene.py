@@ -14,11 +14,12 @@ import shapely
 import planner
 from planner.problem import follow_waypoints
 
-__all__ = ["CURVATURE_RGB", "DRAFT_RGB", "GOAL_RGB", "MOVER_RGB", "OBSTACLE_RGB", "START_RGB", "Z",
-           "add_grid", "car_outline", "curvature_colors", "draw_car", "draw_obstacles",
-           "draw_poses", "draw_track", "fit_camera", "marker_size", "metres_per_px",
-           "motion_table", "move_obstacles", "obstacle_rings", "obstacle_shape", "offset_at",
-           "polyline_segments", "wxyz_yaw", "yaw_wxyz"]
+__all__ = ["CURVATURE_RGB", "CUSP_UNDER_RGB", "DRAFT_RGB", "GOAL_RGB", "MOVER_RGB", "OBSTACLE_RGB",
+           "REVERSE_RGB", "START_RGB", "Z", "add_grid", "arc_length", "car_outline", "curvature_colors",
+           "cusp_rows", "draw_car", "draw_obstacles", "draw_poses", "draw_track", "fit_camera",
+           "ground_point", "marker_size", "metres_per_px", "motion_table", "move_obstacles", "obstacle_rings",
+           "obstacle_shape", "offset_at", "path_layers", "polyline_segments", "reversing",
+           "wxyz_yaw", "yaw_wxyz"]
 
 # Obstacles above the tree: edges pass where a moving obstacle is at other times.
 Z = {"surface": -0.02, "centre": 0.002, "tree": 0.006, "flash": 0.008, "obstacle": 0.009,
@@ -29,6 +30,9 @@ DRAFT_RGB = (255, 120, 0)  # what is being clicked: polygon corners, a drawn tra
 START_RGB, GOAL_RGB = (60, 200, 90), (250, 200, 40)
 OBSTACLE_RGB, MOVER_RGB = (200, 60, 60), (230, 140, 40)  # static and moving obstacles
 CURVATURE_RGB = ((60, 130, 255), (250, 210, 60), (235, 50, 40))  # straight, half, the limit
+# Reversing: dashes of the path's own colour on white, so a pinned run's reverse stays its own;
+# a cusp is a white diamond on a dark one (no other marker in the scene is a diamond).
+REVERSE_RGB, CUSP_UNDER_RGB = (250, 250, 250), (25, 25, 25)
 
 
 def polyline_segments(pts: np.ndarray, z: float, closed: bool = False) -> np.ndarray:
@@ -40,6 +44,50 @@ def polyline_segments(pts: np.ndarray, z: float, closed: bool = False) -> np.nda
     seg[:, 0, :2], seg[:, 1, :2] = pts[:-1], pts[1:]
     seg[:, :, 2] = z
     return seg
+
+
+def arc_length(path: np.ndarray) -> np.ndarray:
+    """The distance driven to each row of a path (x, y in its first columns)."""
+    return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path[:, :2], axis=0).T))])
+
+
+def reversing(path: np.ndarray) -> np.ndarray:
+    """For each piece of a path (rows i to i + 1 of x, y, θ, κ, direction, …), whether the
+    car drives it in reverse: a row's direction is that of the piece ending at it, as
+    `planner` samples paths. A path without a direction column drives forward."""
+    if len(path) < 2 or path.shape[1] < 5:
+        return np.zeros(max(len(path) - 1, 0), bool)
+    return path[1:, 4] < 0
+
+
+def cusp_rows(path: np.ndarray) -> np.ndarray:
+    """The rows where the car stops and changes direction: the piece before and the piece
+    after the row are driven in opposite directions."""
+    rev = reversing(path)
+    return np.flatnonzero(rev[:-1] != rev[1:]) + 1
+
+
+def _diamond(x: float, y: float, r: float, z: float) -> np.ndarray:
+    return polyline_segments(np.array([[x + r, y], [x, y + r], [x - r, y], [x, y - r]]), z,
+                             closed=True)
+
+
+def path_layers(path: np.ndarray, rgb, marker: float, z: float) -> list[tuple]:
+    """A path drawn with its reversing shown, as line layers (suffix, segments, colour, px at
+    scale 1), lowest first: the forward pieces in ``rgb``; the reverse pieces white with
+    dashes of ``rgb`` (each 2 ``marker`` long) over them; a diamond at each cusp. Every layer
+    is returned, empty when the path has none of it, so that a drawing updated in place hides
+    what the new path lacks."""
+    seg = polyline_segments(path[:, :2], z) if len(path) > 1 else np.zeros((0, 2, 3), np.float32)
+    rev = reversing(path)
+    dash = np.floor(arc_length(path)[:-1] / (2 * marker)) % 2 == 0
+    cusps = [_diamond(*path[i, :2], 1.3 * marker, z + 2e-4) for i in cusp_rows(path)]
+    diamonds = np.concatenate(cusps) if cusps else np.zeros((0, 2, 3), np.float32)
+    above = diamonds.copy()
+    above[:, :, 2] += 1e-4
+    return [("", seg[~rev], rgb, 4.0), ("_reverse", seg[rev], REVERSE_RGB, 4.0),
+            ("_reverse_dashes", seg[rev & dash] + np.float32([0, 0, 1e-4]), rgb, 4.0),
+            ("_cusps_under", diamonds, CUSP_UNDER_RGB, 6.0), ("_cusps", above, REVERSE_RGB, 2.5)]
 
 
 def curvature_colors(kappa: np.ndarray, kappa_max: float) -> np.ndarray:
@@ -253,6 +301,16 @@ def add_grid(scene, bounds) -> None:
     scene.add_grid("/grid", size, size, plane="xy", cell_size=cell, section_size=5 * cell,
                    position=((xmin + xmax) / 2, (ymin + ymax) / 2, Z["surface"] - 0.01 * cell),
                    cell_color=(225, 225, 225), section_color=(190, 190, 190))
+
+
+def ground_point(ev) -> tuple[float, float] | None:
+    """Where a click's ray (``ev.ray_origin``, ``ev.ray_direction``) meets the ground z = 0;
+    None when it points away from it."""
+    (ox, oy, oz), (dx, dy, dz) = ev.ray_origin, ev.ray_direction
+    if abs(dz) < 1e-12 or -oz / dz < 0:
+        return None
+    t = -oz / dz
+    return ox + t * dx, oy + t * dy
 
 
 def metres_per_px(camera) -> float | None:

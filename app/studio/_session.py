@@ -31,6 +31,7 @@ from app.studio._edit import Editor
 from app.studio._panel import build_panel
 from app.studio._planner_run import PlannerRun
 from app.studio._projector import Projector
+from app.studio._scene import ground_point
 from app.studio._sim_view import SimView
 from app.studio._sources import Sources
 from app.studio._stage import Stage
@@ -116,6 +117,15 @@ class Session:
         u.animation_download.on_click(lambda _: self._download_animation())
         sim.ui.simulate.on_click(lambda _: self._simulate())
         sim.ui.stop.on_click(lambda _: sim.stop())
+        self.client.scene.on_click()(self._scene_click)
+
+    def _scene_click(self, ev) -> None:
+        """A click on the ground names the edge there (viser 1.1 reports no hover over the
+        scene), unless the click draws a track point or a polygon corner."""
+        p = ground_point(ev)
+        if p is not None and not self.editor.clicking:
+            with self._lock:
+                self.planning.pick(*p)
 
     def _locked(self, fn) -> None:
         with self._lock:

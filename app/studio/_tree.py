@@ -5,6 +5,9 @@ straight pieces along the car's curve. Node i lives in chunk i // CHUNK. The tai
 new nodes land) is re-sent at UI rate; a full chunk is re-sent only when a rewire touched it, a
 few chunks per slow tick. So the bytes per second depend on the chunk size and the rates, never
 on the size of the tree.
+
+Each edge also keeps its local path in segment form (kinds, signed lengths), so that a click on
+it can be answered with its steering word (`nearest`, `planner.path_word`).
 """
 
 from __future__ import annotations
@@ -30,6 +33,8 @@ class EdgeChunks:
     def __init__(self, seg: int = SEG, chunk: int = CHUNK, capacity: int = 4096) -> None:
         self.seg, self.chunk = seg, chunk
         self._pts = np.zeros((capacity, seg + 1, 2), np.float32)
+        self._kinds = np.zeros((capacity, 5), np.int8)
+        self._lens = np.zeros((capacity, 5))
         self._n = 0
         self._tail_dirty = False
         self._sent_n = 0  # nodes the browser had at the last tail push
@@ -44,21 +49,38 @@ class EdgeChunks:
         with self._lock:
             return self._pts[node].copy()
 
-    def set(self, node: int, pts: np.ndarray) -> None:
-        """Record node's edge (a new node, or a rewired one)."""
+    def edge(self, node: int) -> tuple[np.ndarray, np.ndarray]:
+        """Node's local path from its parent: kinds and signed lengths (copies)."""
+        with self._lock:
+            return self._kinds[node].copy(), self._lens[node].copy()
+
+    def set(self, node: int, pts: np.ndarray, kinds=None, lens=None) -> None:
+        """Record node's edge (a new node, or a rewired one): its points and, when given, its
+        local path in segment form."""
         with self._lock:
             if node >= len(self._pts):
-                grown = np.zeros((max(2 * len(self._pts), node + 1), *self._pts.shape[1:]),
-                                 np.float32)
-                grown[:len(self._pts)] = self._pts
-                self._pts = grown
+                size = max(2 * len(self._pts), node + 1)
+                self._pts, self._kinds, self._lens = (
+                    np.concatenate([a, np.zeros((size - len(a), *a.shape[1:]), a.dtype)])
+                    for a in (self._pts, self._kinds, self._lens))
             self._pts[node] = pts
+            if kinds is not None:
+                self._kinds[node], self._lens[node] = kinds, lens
             self._n = max(self._n, node + 1)
             c = node // self.chunk
             if c >= self._sent_n // self.chunk:
                 self._tail_dirty = True
             else:
                 self._dirty[c] = None
+
+    def distances(self, p) -> np.ndarray:
+        """How far each node's edge passes from the point p (x, y): (count,) metres."""
+        with self._lock:
+            pts = self._pts[:self._n].astype(float)
+        a, b = pts[:, :-1], pts[:, 1:]
+        ab, ap = b - a, np.asarray(p, float) - a
+        u = np.clip(np.sum(ap * ab, -1) / np.maximum(np.sum(ab * ab, -1), 1e-18), 0.0, 1.0)
+        return np.hypot(*np.moveaxis(ap - u[..., None] * ab, -1, 0)).min(axis=1)
 
     def _tail_chunk(self) -> int:
         return max(self._n - 1, 0) // self.chunk

@@ -37,6 +37,7 @@ class Live:
     chunks: EdgeChunks = field(default_factory=EdgeChunks)
     flashes: deque = field(default_factory=lambda: deque(maxlen=96))  # (time, old, new)
     best_path: np.ndarray | None = None
+    best_nodes: np.ndarray = field(default_factory=lambda: np.zeros(0, int))  # its tree nodes
     best_version: int = 0
     metrics: dict = field(default_factory=dict)
     metrics_version: int = 0
@@ -176,24 +177,29 @@ class PlannerWorker:
 
     # -- the listener (planner thread) ---------------------------------------------------------
     def _on_events(self, ev: planner.TreeEvents | None) -> None:
-        tree, live = self._tree, self.live
+        live = self.live
         if ev is None:
-            live.chunks.set(0, tree.edge_points(0, SEG))
+            self._record(0)
             return
         for node in (*ev.new[ev.new >= 0], *ev.polished):
-            live.chunks.set(int(node), tree.edge_points(node, SEG))
+            self._record(int(node))
         now = time.monotonic()
         rewired = []
         for rewire in ev.rewires:
             node = rewire.node
             old = live.chunks.get(node)
-            new = tree.edge_points(node, SEG)
-            live.chunks.set(node, new)
+            new = self._record(node)
             live.flashes.append((now, old, new))
             rewired.append((old, new, node))
         if self._stepping and len(ev):
             self._note_step(ev, rewired)
         self._note_best(now)
+
+    def _record(self, node: int) -> np.ndarray:
+        """Node's edge as drawn and as a click names it (its segments); returns its points."""
+        pts = self._tree.edge_points(node, SEG)
+        self.live.chunks.set(node, pts, *self._tree.edge_segments(node))
+        return pts
 
     def _note_step(self, ev: planner.TreeEvents, rewired: list) -> None:
         """The iteration as the step overlay and the EXTEND panel show it: a blocked Steer's
@@ -222,6 +228,7 @@ class PlannerWorker:
         if cost is not None and (self._best is None or cost < self._best - 1e-9):
             self._best = cost
             if not self._optimal:  # else the schedule, timed with the metrics
+                live.best_nodes = np.array(tree.best_path_nodes())
                 self._show_path(tree.dense_path(0.05))
             live.cost_over_time = tree.cost_over_time
         if now - self._last_metrics >= 0.5 or self._stepping:
