@@ -33,6 +33,7 @@ STATIC_SCENARIOS = ["open_field", "hallway", "slalom", "parking", "oval_track"]
 OMPL_PLANNERS = ["RRTstar", "InformedRRTstar", "BITstar"]
 OURS = "ours"
 BEST_KNOWN = Path(__file__).parent / "results" / "best_known.json"
+AB_RECORD = "## A/B record"  # a hand-kept section below the tables, kept when they are rewritten
 LONG_SEEDS = [0, 1, 2]
 
 
@@ -46,10 +47,17 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--budgets", nargs="+", type=float, default=[0.1, 1.0], metavar="SECONDS")
     parser.add_argument("--only", choices=[OURS, "ompl"], help="run only our planner or only OMPL")
     parser.add_argument("--json", type=Path, metavar="OUT", help="also write every run's record")
+    parser.add_argument("--ompl-from", type=Path, metavar="RECORDS",
+                        help="take OMPL's runs from an earlier --json instead of running OMPL "
+                             "again (12 minutes of fresh processes; OMPL does not change with "
+                             "our commits), e.g. benchmarks/results/ompl_runs.json")
     parser.add_argument("--out", default="planner", metavar="NAME",
                         help="write the tables to benchmarks/results/NAME.md")
     parser.add_argument("--long-s", type=float, default=20.0, metavar="SECONDS",
                         help="budget of the long runs that find a missing best known cost")
+    parser.add_argument("--renew-best-known", action="store_true",
+                        help="run the long runs again for every scenario (after a planner "
+                             "change); a stored cost that stays lower is kept")
     args = parser.parse_args(argv)
     args.budgets = sorted(args.budgets)
     return args
@@ -69,6 +77,20 @@ def ompl_runs(scenarios: dict[str, dict], seeds: list[int], budgets: list[float]
                     records.append(run_ompl_isolated(scenario, name, budget, seed))
                     bar.update()
     return records
+
+
+def kept_record(name: str) -> str:
+    """The A/B record below the tables of results/NAME.md, if it has one."""
+    path = _harness.RESULTS / f"{name}.md"
+    text = path.read_text() if path.exists() else ""
+    return "\n" + text[text.index(AB_RECORD):] if AB_RECORD in text else ""
+
+
+def ompl_records(path: Path, args: argparse.Namespace) -> list[dict]:
+    """OMPL's records in an earlier --json, for these scenarios, seeds and budgets."""
+    return [r for r in json.loads(path.read_text())
+            if r["planner"] != OURS and r["scenario"] in args.scenarios
+            and r["seed"] in args.seeds and r["time_limit_s"] in args.budgets]
 
 
 def _our_planner():
@@ -122,14 +144,15 @@ def _our_record(result, scenario: str, seed: int, budget: float, setup_s: float)
 
 
 def best_known(trackstar, paths: dict[str, Path], scenarios: dict[str, dict], long_s: float,
-               with_ompl: bool) -> dict[str, dict]:
-    """{scenario: {"cost", "by"}}: stored ones, and long runs for the missing ones (stored)."""
+               with_ompl: bool, renew: bool = False) -> dict[str, dict]:
+    """{scenario: {"cost", "by"}}: stored ones, and long runs for the missing ones (for all
+    with ``renew``, keeping a stored cost that stays lower); stored."""
     known = json.loads(BEST_KNOWN.read_text()) if BEST_KNOWN.exists() else {}
-    missing = [name for name in paths if name not in known]
+    missing = [name for name in paths if renew or name not in known]
     runs = len(missing) * len(LONG_SEEDS) * (2 if with_ompl else 1)
     with tqdm(total=runs, unit="long run", disable=not runs) as bar:
         for name in missing:
-            found = []
+            found = [(known[name]["cost"], known[name]["by"])] if name in known else []
             for seed in LONG_SEEDS:
                 bar.set_postfix_str(f"{name} ours seed {seed}")
                 result = trackstar.solve(trackstar.load_scenario(paths[name]), time_limit=long_s,
@@ -270,7 +293,9 @@ def report(summary: dict, args: argparse.Namespace, command: str, seconds: float
         f"`{command}` — Trackstar {_revision()}, {date.today()}, {platform.machine()}, "
         f"Python {platform.python_version()}, seeds {args.seeds}, {seconds:.0f} s in all; load "
         f"average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs at the end (above ~1, other "
-        "processes shared the CPU and the speeds are low).",
+        "processes shared the CPU and the speeds are low)."
+        + (f" OMPL's rows are its runs recorded in {args.ompl_from}, not run again."
+           if args.ompl_from else ""),
         NOTES,
         results_table(summary, args.scenarios, args.budgets),
     ]
@@ -293,12 +318,13 @@ def main(argv: list[str] | None = None) -> None:
     paths = dict(zip(scenarios, files))
     args.scenarios = list(scenarios)
     runs_per_planner = len(paths) * len(args.seeds)
-    n_ompl = 0 if args.only == OURS else runs_per_planner * len(OMPL_PLANNERS) * len(args.budgets)
+    n_ompl = (0 if args.only == OURS or args.ompl_from
+              else runs_per_planner * len(OMPL_PLANNERS) * len(args.budgets))
     n_ours = 0 if args.only == "ompl" else runs_per_planner
 
     ours = _our_planner() if n_ours else None  # fails before the OMPL runs, not after them
     start = time.perf_counter()
-    records: list[dict] = []
+    records = ompl_records(args.ompl_from, args) if args.ompl_from else []
     with tqdm(total=n_ompl + n_ours, unit="run") as bar:
         if n_ours:
             records += our_runs(ours, paths, args.seeds, args.budgets, bar)
@@ -306,13 +332,14 @@ def main(argv: list[str] | None = None) -> None:
             records += ompl_runs(scenarios, args.seeds, args.budgets, bar)
     options = sys.argv[1:] if argv is None else argv
     command = " ".join(["python benchmarks/bench_planner.py", *options])
-    known = (best_known(ours, paths, scenarios, args.long_s, with_ompl=args.only is None)
+    with_ompl = args.only is None and args.ompl_from is None
+    known = (best_known(ours, paths, scenarios, args.long_s, with_ompl, args.renew_best_known)
              if ours is not None else {})
     text = report(summarise(records, args.budgets), args, command, time.perf_counter() - start,
                   known)
 
     print(text)
-    _harness.write_result(args.out, text)
+    _harness.write_result(args.out, text + kept_record(args.out))
     if args.json:
         args.json.write_text(json.dumps(records, indent=1))
 
