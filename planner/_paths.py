@@ -23,6 +23,7 @@ from planner._jit import njit
 MAX_SEGMENTS = 5
 LEFT, STRAIGHT, RIGHT, TURN = 1, 0, -1, 2
 _TWO_PI = 2.0 * math.pi
+MIN_SEGMENT = 1e-6  # m: a shorter driven segment (a Dubins word's vanishing middle) is none
 _LETTERS = {LEFT: "L", STRAIGHT: "S", RIGHT: "R", TURN: "T"}
 
 
@@ -31,8 +32,9 @@ def path_word(kinds, lens) -> str:
     straight, R right arc, T turn on the spot ("LSL", "RSR", "TST"); unused segments are left
     out. A path that reverses anywhere gives each driven segment its direction, + forward and
     − reverse, as Reeds and Shepp write their words ("L+R−S−"): a forward-only word stays short,
-    the way Dubins words are known. A turn on the spot drives no way and has no direction. The
-    empty path (the root's) has the empty word.
+    the way Dubins words are known. A turn on the spot drives no way and has no direction. A
+    segment under `MIN_SEGMENT` has no letter, as it has no row in `sample_path`. The empty path
+    (the root's) has the empty word.
 
     >>> import numpy as np
     >>> path_word(np.array([1, 0, 1, 0, 0]), np.array([0.5, 2.0, 0.3, 0.0, 0.0]))
@@ -40,7 +42,7 @@ def path_word(kinds, lens) -> str:
     >>> path_word(np.array([1, -1, 0, 0, 0]), np.array([0.4, -0.9, -1.0, 0.0, 0.0]))
     'L+R−S−'
     """
-    segs = [(int(k), float(v)) for k, v in zip(kinds, lens) if v != 0.0]
+    segs = [(int(k), float(v)) for k, v in zip(kinds, lens) if _sampled.py_func(k, v)]
     reverses = any(v < 0.0 and k != TURN for k, v in segs)
     return "".join(_LETTERS[k] + ("" if not reverses or k == TURN else "+" if v > 0 else "−")
                    for k, v in segs)
@@ -170,7 +172,7 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
 
 @njit(cache=True, inline="always")
 def _sampled(kind: int, seg: float) -> bool:
-    return seg != 0.0 and (kind == TURN or abs(seg) > 1e-6)
+    return seg != 0.0 and (kind == TURN or abs(seg) > MIN_SEGMENT)
 
 
 @njit(cache=True, inline="always")

@@ -71,12 +71,13 @@ def test_a_turn_on_the_spot_is_t_without_a_direction():
 @settings(max_examples=100, deadline=None)
 @given(kinds_st, st.lists(lengths, min_size=5, max_size=5))
 def test_the_word_names_the_segments_a_path_samples(kinds, lens):
-    """One letter per segment that moves, and where a sign is written it is the driving
-    direction `sample_path` gives that segment's poses."""
+    """One letter per segment that moves (a micrometre at least, or a turn on the spot), and
+    where a sign is written it is the driving direction `sample_path` gives that segment's
+    poses."""
     kinds, lens = np.array(kinds, dtype=np.int8), np.array(lens)
     word = path_word(kinds, lens)
     letters = [c for c in word if c in "LSR"]
-    assert letters == ["LSR"[1 - k] for k, v in zip(kinds, lens) if v != 0.0]
+    assert letters == ["LSR"[1 - k] for k, v in zip(kinds, lens) if abs(v) > 1e-6]
     signs = [c for c in word if c in "+−"]
     rows = sample_path(0.0, 0.0, 0.0, kinds, lens, 1.0, 10.0)[1:, 4]  # a row per segment
     assert signs == ([] if (rows > 0).all() else ["+" if d > 0 else "−" for d in rows])

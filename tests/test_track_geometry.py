@@ -157,3 +157,12 @@ def test_steering_angle_is_atan_of_wheelbase_times_curvature_and_flags_tight_tur
     assert np.allclose(prof.steering_deg, math.degrees(math.atan(0.44 / r)))
     assert not prof.feasible.any()
     assert track_of(arc).sample(max_steer_deg=30).feasible.all()
+
+
+def test_an_arc_between_endpoints_too_close_to_tell_apart_is_omitted_like_a_closed_one():
+    """SVG omits an arc whose endpoints coincide; 1e-170 apart, their distance squares to 0 and
+    no centre can be computed (it was NaN, silently)."""
+    assert arc_from_endpoints((0.0, 0.0), (0.0, 0.0), (1.0, 1.0), 0.0, False, True) is None
+    assert arc_from_endpoints((0.0, 0.0), (1e-170, 0.0), (1.0, 1.0), 0.0, False, True) is None
+    arc = arc_from_endpoints((0.0, 0.0), (1e-9, 0.0), (1.0, 1.0), 0.0, False, True)
+    assert np.all(np.isfinite(arc.center))

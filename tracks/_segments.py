@@ -152,6 +152,8 @@ def arc_from_endpoints(
         factor = 0.0
     else:
         den = (rx * y1) ** 2 + (ry * x1) ** 2
+        if den == 0.0:  # endpoints a few 1e-160 apart: coincident to the arithmetic
+            return None
         factor = math.sqrt(max(0.0, ((rx * ry) ** 2 - den) / den))
     if large_arc == sweep:
         factor = -factor
