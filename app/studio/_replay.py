@@ -55,12 +55,14 @@ def parents_at(node_iteration: np.ndarray, first_parent: np.ndarray, rewires: np
 @dataclass(frozen=True)
 class Frame:
     """The tree after ``iteration``: ``parent`` per node (its length is the node count), the
-    best cost then (None: no solution yet) and the best path drawn for it (rows as
-    `Live.best_path`; None: none), which is the one found at ``path_iteration``."""
+    best cost then (None: no solution yet), reached at ``cost_iteration``, and the best path
+    drawn for it (rows as `Live.best_path`; None: none), the one drawn at ``path_iteration``
+    (the same iteration unless the cost fell again inside one of the planner's batches)."""
 
     iteration: int
     parent: np.ndarray
     cost: float | None
+    cost_iteration: int | None
     path: np.ndarray | None
     path_iteration: int | None
 
@@ -158,7 +160,8 @@ class TreeRecord:
             n = min(max(int(n), 0), self.iterations)
             parent = parents_at(self._iter[:self._n], self._first[:self._n],
                                 self._rw[:self._m], n)
-            cost = next((c for i, c in reversed(self._costs) if i <= n), None)
+            cost_at = next(((i, c) for i, c in reversed(self._costs) if i <= n), (None, None))
             path_at = next(((i, p) for i, p in reversed(self._paths) if i <= n), (None, None))
-        cost = cost if cost is not None and np.isfinite(cost) else None
-        return Frame(n, parent, cost, path_at[1], path_at[0])
+        if cost_at[1] is None or not np.isfinite(cost_at[1]):
+            cost_at = (None, None)
+        return Frame(n, parent, cost_at[1], cost_at[0], path_at[1], path_at[0])
