@@ -29,6 +29,7 @@ from app.studio._scene import (
     path_layers,
     polyline_segments,
 )
+from app.studio._tree import EdgeChunks
 from app.studio._worker import FLASH_S, Live
 
 __all__ = ["LEGEND", "LiveView", "Look", "edge_label", "legend_html", "place_labels",
@@ -204,6 +205,7 @@ class LiveView:
         self._seen = {"best": 0, "step": 0}
         self._ticks = 0
         self.sent_chunks = 0
+        self.replaying = False  # the scene shows a past iteration (`replay`), not the run
 
     def restyle(self, look: Look) -> None:
         """Draw what is there, and what comes, with ``look``."""
@@ -233,11 +235,25 @@ class LiveView:
             h.visible = True
 
     def tick(self) -> None:
+        if self.replaying:  # the past iteration stays until `live_again`
+            return
         self._ticks += 1
         chunks = self.live.chunks
         sends = chunks.take_tail()
         if self._ticks % SLOW_EVERY == 0:
             sends += chunks.take_rewired(REWIRED_PER_SLOW_TICK)
+        self._send_chunks(sends)
+        if self._ticks % FLASH_EVERY == 0:
+            self._flashes()
+        if self.live.best_version != self._seen["best"]:
+            self._seen["best"] = self.live.best_version
+            self._draw_path(self.live.best_path)
+        if self.live.step_version != self._seen["step"]:
+            self._seen["step"] = self.live.step_version
+            self._step_overlay(self.live.step)
+
+    def _send_chunks(self, sends: list[tuple[int, np.ndarray]]) -> None:
+        """Chunks of tree edges (`EdgeChunks.segments`) into the scene, each in its node."""
         for c, seg in sends:
             seg[:, :, 2] = Z["tree"]
             h = self._chunks.get(c)
@@ -247,17 +263,43 @@ class LiveView:
                     thickness=TREE_PX * self.look.scale, thickness_units="screen")
             else:
                 h.points = seg
+                if not h.visible:
+                    h.visible = True
             self.sent_chunks += 1
-        if self._ticks % FLASH_EVERY == 0:
-            self._flashes()
-        if self.live.best_version != self._seen["best"]:
-            self._seen["best"] = self.live.best_version
-            for suffix, seg, rgb, px in path_layers(self.live.best_path, PATH_RGB, self.marker,
-                                                    Z["path"]):
-                self._put(f"best{suffix}", seg, rgb, px)
-        if self.live.step_version != self._seen["step"]:
-            self._seen["step"] = self.live.step_version
-            self._step_overlay(self.live.step)
+
+    def _draw_path(self, path: np.ndarray | None) -> None:
+        """The best path's layers (`path_layers`); None (no path) hides them."""
+        if path is None or len(path) < 2:
+            for name, h in self._handles.items():
+                if name.startswith("best"):
+                    h.visible = False
+            return
+        for suffix, seg, rgb, px in path_layers(path, PATH_RGB, self.marker, Z["path"]):
+            self._put(f"best{suffix}", seg, rgb, px)
+
+    def replay(self, edges: EdgeChunks, path: np.ndarray | None) -> None:
+        """Show a past iteration instead of the run: the tree of ``edges`` (drawn like the
+        live tree, chunk by chunk, the chunks past it hidden) and its best path; the rewire
+        flashes, the step overlay and a clicked edge's label go."""
+        self.replaying = True
+        self._send_chunks([(c, edges.segments(c)) for c in range(edges.chunks)])
+        for c, h in self._chunks.items():
+            if c >= edges.chunks and h.visible:
+                h.visible = False
+        self._draw_path(path)
+        for name, h in self._handles.items():
+            if name.startswith(("step_", "flash_", "pick")):
+                h.visible = False
+
+    def live_again(self) -> None:
+        """Back from `replay` to the run: every chunk, the best path and the step overlay are
+        drawn anew from the run's record."""
+        if not self.replaying:
+            return
+        self.replaying = False
+        chunks = self.live.chunks
+        self._send_chunks([(c, chunks.segments(c)) for c in range(chunks.chunks)])
+        self._seen = {"best": -1, "step": -1}
 
     def _flashes(self) -> None:
         now = time.monotonic()
@@ -315,7 +357,10 @@ class LiveView:
     def pick(self, x: float, y: float) -> str | None:
         """A click on the ground at (x, y): the edge drawn there — of the best path first,
         else of the tree — gets a halo and a label with its word (`edge_label`); a click
-        beside every edge takes them away. Returns the label's text (None: no edge)."""
+        beside every edge takes them away. Returns the label's text (None: no edge). The
+        live tree's edges only: while a past iteration is shown, clicks name nothing."""
+        if self.replaying:
+            return None
         chunks = self.live.chunks
         view = metres_per_px(self.camera) if self.camera is not None else None
         reach = PICK_PX * self.look.scale * (view or self.marker / MARKER_PX)

@@ -70,6 +70,8 @@ class Panel:
     pause: object
     step: object
     reset: object
+    replay: object
+    replay_note: object
     pin: object
     clear_pins: object
     pins_legend: object
@@ -172,6 +174,11 @@ def build_panel(gui) -> Panel:
         pause = gui.add_button("Pause")
         step = gui.add_button("Step")
         reset = gui.add_button("Reset")
+        replay = gui.add_slider(
+            "Replay (iteration)", 0, 1, 1, 0, disabled=True,
+            hint="When the run is paused or done: the tree and the best path as they stood "
+                 "after this iteration; the last one, Run or Step go back to the run")
+        replay_note = gui.add_markdown("Replay: pause or finish a run")
         pin = gui.add_button(
             "Pin this run", hint="Keeps this run's best path, profiles and cost over time "
                                  "drawn in a colour of its own under the next runs (4 at most: "

@@ -25,12 +25,14 @@ from app.studio._panel import DEFAULT_BUDGET, PLANNERS, SPEEDS, STEERINGS, TIMIN
 from app.studio._plots import Profiles
 from app.studio._scenario import goal_fraction
 from app.studio._scene import draw_car, marker_size, yaw_wxyz
+from app.studio._tree import EdgeChunks
 from app.studio._worker import PlannerWorker
 from planner.validation import describe
 
 __all__ = ["PlannerRun", "pose_at_time"]
 
 PLOT_S = 1.0  # profile plots redraw at most this often (uPlot re-renders all of it)
+OLD_EDGES = 300_000  # replayed edges a tree no longer holds, kept at most (a few 10 MB)
 
 
 class PlannerRun:
@@ -46,6 +48,7 @@ class PlannerRun:
         self._shown: dict = {}  # versions of the worker's record already shown
         self.pins = Pins(scene)
         self._track = None  # the pins' track
+        self._old_edges: dict[tuple[int, int], np.ndarray] = {}  # (node, parent): its points
 
     def new_track(self, track: tracks.Track, vehicle) -> None:
         """The stage cleared the scene (the run's drawing went with it): profile plots of the
@@ -98,7 +101,8 @@ class PlannerRun:
                                     SPEEDS[self.ui.rate.value])
         self._view = LiveView(self.scene, self.worker.live, problem.bounds, self.look,
                               self.stage.client.camera)
-        self._shown = {"metrics": -1, "best": 0, "step": 0, "cost": 0}
+        self._shown = {"metrics": -1, "best": 0, "step": 0, "cost": 0, "replay": -1}
+        self._old_edges.clear()
         self._driving = False
         if self._car is not None:
             self._car.remove()
@@ -114,6 +118,13 @@ class PlannerRun:
         if self.worker is not None:
             self.worker.stop()
 
+    def resume(self, command: str) -> None:
+        """`Run`, `Pause` or `Step` (the worker's command); Run and Step go back from a replay
+        to the run first."""
+        if command != "pause":
+            self.replay_end()
+        getattr(self.worker, command)()
+
     def set_rate(self) -> None:
         self.worker.rate = SPEEDS[self.ui.rate.value]
 
@@ -122,6 +133,7 @@ class PlannerRun:
         if until == "rewire" and self.ui.planner_name.value != "RRT*":
             self.notify("RRT never rewires", "choose the planner RRT* to see rewires")
             return
+        self.replay_end()
         self.worker.step(until)
 
     @property
@@ -148,6 +160,69 @@ class PlannerRun:
         """A click on the ground at (x, y): the edge there says its word (`LiveView.pick`)."""
         if self._view is not None:
             self._view.pick(x, y)
+
+    # -- replay --------------------------------------------------------------------------------
+    def replay(self, n: int) -> None:
+        """The replay slider at iteration n: the tree and the best path as they stood then, on
+        a paused or finished run (the worker's `TreeRecord`); at its last iteration, the run."""
+        if self._view is None or self.worker.live.state == "running":
+            return
+        record = self.worker.record
+        if n >= record.iterations:
+            self.replay_end()
+            return
+        frame = record.frame(n)
+        edges = EdgeChunks(capacity=1)
+        edges.fill(self._replayed_edges(frame))
+        self._view.replay(edges, frame.path)
+        self.ui.replay_note.content = _replay_md(frame, record)
+
+    def replay_end(self) -> None:
+        """Back to the run from a replay: the slider at its end."""
+        if self._view is None or not self._view.replaying:
+            return
+        self._view.live_again()
+        end = self.worker.record.iterations
+        self.ui.replay_note.content = _replay_md(None, self.worker.record)
+        self.ui.replay.value = end
+
+    def _replayed_edges(self, frame) -> np.ndarray:
+        """The edges of ``frame``'s tree: as drawn live where a node's parent is still the
+        one it had then, else the steering between the two poses (a rewire replaced the edge;
+        kept for the next frames). A record that stopped steers every edge (the live tree
+        went on from where it ends)."""
+        record, n = self.worker.record, frame.nodes
+        pts = self.worker.live.chunks.points(n)
+        if record.note is None:
+            final = record.frame(record.iterations).parent[:n]
+            old = np.flatnonzero(frame.parent != final)
+        else:
+            old = np.arange(1, n)
+        poses = record.poses(n)
+        if len(self._old_edges) + len(old) > OLD_EDGES:
+            self._old_edges.clear()
+        for node in old.tolist():
+            up = int(frame.parent[node])
+            edge = self._old_edges.get((node, up))
+            if edge is None:
+                edge = self._old_edges[node, up] = self.worker.steer_points(poses[up],
+                                                                             poses[node])
+            pts[node] = edge
+        return pts
+
+    def _tick_replay(self, live) -> None:
+        """The slider follows the record: usable once the run is paused or done, at its end
+        while the run is shown."""
+        slider, end = self.ui.replay, self.worker.record.iterations
+        idle = live.state != "running"
+        if slider.disabled == (idle and end > 0):
+            slider.disabled = not (idle and end > 0)
+        if self._view.replaying or self._shown["replay"] == end:
+            return
+        self._shown["replay"] = end
+        slider.max = max(end, 1)
+        slider.value = end
+        self.ui.replay_note.content = _replay_md(None, self.worker.record)
 
     # -- compare runs --------------------------------------------------------------------------
     def current(self) -> Run | None:
@@ -232,6 +307,7 @@ class PlannerRun:
             return
         live = self.worker.live
         self._view.tick()
+        self._tick_replay(live)
         status = f"Status: **{live.state}**" + (f" — {live.error}" if live.error else "")
         if status != self.ui.status.content:  # GUI updates re-render the panel: only changes
             self.ui.status.content = status
@@ -264,6 +340,24 @@ def pose_at_time(path: np.ndarray, t: float) -> tuple[float, float, float]:
     one pose, t rising) the car stands still."""
     k = int(np.searchsorted(path[:, 5], t).clip(0, len(path) - 1))
     return tuple(float(v) for v in path[k, :3])
+
+
+def _replay_md(frame, record) -> str:
+    """The replay's line under its slider: the iteration shown of those recorded, its nodes
+    and best cost (None: the run itself)."""
+    end = record.iterations
+    if frame is None:
+        text = (f"Replay: iteration {end:,} of {end:,} (the run)" if end
+                else "Replay: pause or finish a run")
+    else:
+        cost = "no path yet" if frame.cost is None else f"best cost {frame.cost:.4g} m"
+        text = (f"Replay: iteration {frame.iteration:,} of {end:,} · {frame.nodes:,} nodes · "
+                f"{cost}")
+        if frame.cost is not None and frame.path_iteration != frame.cost_iteration:
+            text += (" (no path drawn for it)" if frame.path is None else
+                     f" (the path drawn is the one of iteration {frame.path_iteration:,}: "
+                     "the cost fell again inside one of the planner's batches)")
+    return text + (f". {record.note}." if record.note else "")
 
 
 def _fmt(v, unit: str = "", digits: int = 3) -> str:

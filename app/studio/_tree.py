@@ -49,6 +49,24 @@ class EdgeChunks:
         with self._lock:
             return self._pts[node].copy()
 
+    def points(self, count: int) -> np.ndarray:
+        """The first ``count`` nodes' edges, (count, seg + 1, 2) (a copy)."""
+        with self._lock:
+            return self._pts[:count].copy()
+
+    def fill(self, pts: np.ndarray) -> None:
+        """Hold exactly these edges, (count, seg + 1, 2), node i's at i (a replayed tree)."""
+        with self._lock:
+            self._pts = np.array(pts, np.float32)
+            self._kinds = np.zeros((len(pts), 5), np.int8)
+            self._lens = np.zeros((len(pts), 5))
+            self._n = len(pts)
+
+    @property
+    def chunks(self) -> int:
+        """How many chunks the edges fill."""
+        return -(-self._n // self.chunk)
+
     def edge(self, node: int) -> tuple[np.ndarray, np.ndarray]:
         """Node's local path from its parent: kinds and signed lengths (copies)."""
         with self._lock:

@@ -21,6 +21,7 @@ import numpy as np
 
 import planner
 from app.studio._extend import StepInfo
+from app.studio._replay import TreeRecord
 from app.studio._tree import SEG, EdgeChunks
 
 __all__ = ["Live", "PlannerWorker"]
@@ -63,6 +64,7 @@ class PlannerWorker:
         self._optimal = options.timing == "optimal"
         self._tree = self._run.route if self._optimal else self._run  # the tree drawn
         self._tree.add_listener(self._on_events)
+        self.record = TreeRecord(self._tree.root)  # what the replay slider rebuilds from
         self._stepped = 0  # iterations asked of each tree
         self._result = self._timed_costs = None  # timing optimal: the result shown, and of what
         self._star = options.planner == "rrtstar"
@@ -89,6 +91,11 @@ class PlannerWorker:
         """One iteration; with ``until`` ("node" or "rewire") single iterations until one adds
         a node or rewires (`STEP_CAP` at most). The last one is shown."""
         self._cmds.put(f"step {until}" if until else "step")
+
+    def steer_points(self, a, b) -> np.ndarray:
+        """(SEG + 1, 2) positions along the steering from pose a to pose b: an edge the tree
+        held once (the replay draws a rewired node's old edge); any thread (no tree state)."""
+        return self._tree.steer_points(a, b, SEG)
 
     def stop(self) -> None:
         self._cmds.put("stop")
@@ -193,6 +200,7 @@ class PlannerWorker:
             rewired.append((old, new, node))
         if self._stepping and len(ev):
             self._note_step(ev, rewired)
+        self.record.add(ev, self._tree.poses, self._tree.nodes, self._tree.rewires)
         self._note_best(now)
 
     def _record(self, node: int) -> np.ndarray:
@@ -230,6 +238,7 @@ class PlannerWorker:
             if not self._optimal:  # else the schedule, timed with the metrics
                 live.best_nodes = np.array(tree.best_path_nodes())
                 self._show_path(tree.dense_path(0.05))
+                self.record.add_path(live.best_path)
             live.cost_over_time = tree.cost_over_time
         if now - self._last_metrics >= 0.5 or self._stepping:
             self._last_metrics = now
