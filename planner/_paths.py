@@ -23,7 +23,7 @@ from planner._jit import njit
 MAX_SEGMENTS = 5
 LEFT, STRAIGHT, RIGHT, TURN = 1, 0, -1, 2
 _TWO_PI = 2.0 * math.pi
-MIN_SEGMENT = 1e-6  # m: a shorter driven segment (a Dubins word's vanishing middle) is none
+MIN_SEGMENT = 1e-9  # m: a shorter driven segment (a Dubins word's vanishing middle) is none
 _LETTERS = {LEFT: "L", STRAIGHT: "S", RIGHT: "R", TURN: "T"}
 
 
@@ -136,7 +136,7 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
 
     Returns an (n, 5) array of x, y, theta, curvature (steering curvature: kind/ρ), direction.
     A turn on the spot is one row: the same position, the new heading, curvature 0 (the robot
-    does not steer; its heading is free). A segment shorter than a micrometre (a Dubins word's
+    does not steer; its heading is free). A segment under `MIN_SEGMENT` (a Dubins word's
     vanishing middle) moves the pose but gives no row: it would repeat the one before.
     """
     n = 1

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from planner._paths import path_end, path_length, path_word, pose_at, sample_path
+from planner._paths import MIN_SEGMENT, path_end, path_length, path_word, pose_at, sample_path
 
 lengths = st.floats(-5, 5, allow_nan=False)
 kinds_st = st.lists(st.sampled_from([-1, 0, 1]), min_size=5, max_size=5)
@@ -28,7 +28,8 @@ def test_samples_are_continuous_and_end_at_the_end(kinds, lens, rho):
     pts = sample_path(0.5, -0.2, 0.3, kinds, lens, rho, 0.02)
     end = path_end(0.5, -0.2, 0.3, kinds, lens, rho)
     assert np.allclose(pts[-1, :3], end, atol=1e-9)
-    assert np.all(np.hypot(*np.diff(pts[:, :2], axis=0).T) <= 0.02 + 1e-9)
+    # A segment under MIN_SEGMENT has no row: the step over it is that much longer.
+    assert np.all(np.hypot(*np.diff(pts[:, :2], axis=0).T) <= 0.02 + 6 * MIN_SEGMENT)
     mid = pose_at(0.5, -0.2, 0.3, kinds, lens, rho, path_length(kinds, lens))
     assert np.allclose(mid[:3], end, atol=1e-9)
 
@@ -71,13 +72,13 @@ def test_a_turn_on_the_spot_is_t_without_a_direction():
 @settings(max_examples=100, deadline=None)
 @given(kinds_st, st.lists(lengths, min_size=5, max_size=5))
 def test_the_word_names_the_segments_a_path_samples(kinds, lens):
-    """One letter per segment that moves (a micrometre at least, or a turn on the spot), and
+    """One letter per segment that moves (MIN_SEGMENT at least, or a turn on the spot), and
     where a sign is written it is the driving direction `sample_path` gives that segment's
     poses."""
     kinds, lens = np.array(kinds, dtype=np.int8), np.array(lens)
     word = path_word(kinds, lens)
     letters = [c for c in word if c in "LSR"]
-    assert letters == ["LSR"[1 - k] for k, v in zip(kinds, lens) if abs(v) > 1e-6]
+    assert letters == ["LSR"[1 - k] for k, v in zip(kinds, lens) if abs(v) > MIN_SEGMENT]
     signs = [c for c in word if c in "+−"]
     rows = sample_path(0.0, 0.0, 0.0, kinds, lens, 1.0, 10.0)[1:, 4]  # a row per segment
     assert signs == ([] if (rows > 0).all() else ["+" if d > 0 else "−" for d in rows])

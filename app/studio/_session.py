@@ -102,7 +102,8 @@ class Session:
                         u.goal_bias, u.budget, u.seed):
             control.on_update(lambda _: self._locked(run.reset))
         u.reset.on_click(lambda _: self._locked(run.reset))
-        u.rate.on_update(lambda _: run.set_rate())
+        # Commands under the lock too: a reset replaces the worker, and they must reach the new one.
+        u.rate.on_update(lambda _: self._locked(run.set_rate))
         u.step_node.on_click(lambda _: self._locked(lambda: run.step("node")))
         u.step_rewire.on_click(lambda _: self._locked(lambda: run.step("rewire")))
         for button, command in ((u.run, "run"), (u.pause, "pause"), (u.step, "step")):
