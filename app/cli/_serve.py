@@ -7,7 +7,6 @@ here and handed to uvicorn, so port 0 works and the printed port is the real one
 
 from __future__ import annotations
 
-import asyncio
 import ipaddress
 import os
 import signal
@@ -55,6 +54,8 @@ def _api_url(host: str, port: int, access: Access) -> str:
 
 
 async def _run(app, api: socket.socket, host: str, ui: socket.socket) -> None:
+    import asyncio  # here, not at the top: every other command would pay its 20 ms
+
     import uvicorn
 
     from app.studio import launch
@@ -143,6 +144,8 @@ def serve(
         # uvicorn re-raises the stop signal once it has shut down; we have already stopped.
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, lambda *_: None)
+        import asyncio
+
         asyncio.run(_run(create_app(settings), api, host, ui))
 
 
