@@ -222,54 +222,6 @@ def test_scene_renders_a_library_track_and_run_grows_the_tree(browser, ui_url):
     page.close()
 
 
-def reverse_pixels(img: np.ndarray) -> np.ndarray:
-    """Where reversing is drawn: white (250, 250, 250, shaded to 225) under the best path's
-    magenta dashes, within 4 px of them (the view's background is white too)."""
-    pink = np.abs(img - [255, 90, 200]).sum(axis=2) < 60
-    near = np.zeros_like(pink)
-    for dy in range(-4, 5):
-        for dx in range(-4, 5):
-            near |= np.roll(pink, (dy, dx), axis=(0, 1))
-    return (np.abs(img - 225) <= 8).all(axis=2) & near
-
-
-def test_reeds_shepp_reversing_is_drawn_and_a_clicked_edge_says_its_word(browser, urls):
-    """Parking with Reeds-Shepp reverses into the slot: the reverse stretch is drawn white
-    with pink dashes, the cusp as a diamond, and a click on it names the edge's word."""
-    page = open_tab(browser, urls["ui"])
-    show_folder(page, "Scenario", "Load from server")
-    set_text(page, "Name", "parking")
-    click(page, "Load from server")
-    wait_until(page, lambda img: red(img).sum() > 1000)
-    wait_still(page)
-    before = reverse_pixels(canvas_pixels(page)).sum()
-    page.get_by_label("Steering", exact=True).click(force=True)
-    page.get_by_role("option", name="Reeds-Shepp", exact=True).click(force=True)
-    page.locator("tr", has_text="rewires").wait_for(state="detached")
-    click(page, "Run")
-    page.locator("tr", has_text="cost").first.get_by_text(re.compile(r"^[\d.]+ m$")).wait_for()
-    time.sleep(1.0)
-    click(page, "Pause")
-    img = wait_until(page, lambda img: reverse_pixels(img).sum() > before + 30)
-    wait_still(page)
-    img = canvas_pixels(page, "15_reverse")
-    white = np.argwhere(reverse_pixels(img))
-    assert len(white) > before + 30, "no reverse stretch drawn"
-    y, x = white[len(white) // 2]
-    page.mouse.click(float(x), float(y))
-    # The edge gets a pale yellow halo and a label (drawn in WebGL: its words are not in the
-    # page; the unit tests read them).
-    halo = wait_until(page, lambda shot: (np.abs(shot - img).sum(axis=2) > 60).sum() > 300)
-    assert (np.abs(halo - img).sum(axis=2) > 60).sum() > 300, "the click drew nothing"
-    wait_still(page)
-    canvas_pixels(page, "15_reverse")
-    plot = page.locator(".uplot").first
-    plot.scroll_into_view_if_needed()
-    assert page.locator(".u-legend", has_text="reverse (shaded)").count() == 2
-    plot.screenshot(path=str(ARTIFACTS / "15_reverse_profile.png"))
-    page.close()
-
-
 def test_step_highlights_a_line_of_extend_and_draws_the_iteration(browser, ui_url):
     page = open_tab(browser, ui_url)
     panel = page.locator("pre", has_text="SampleFree")
