@@ -426,9 +426,10 @@ def warm_up() -> None:
         return
     from planner._world import build_world
 
-    world = build_world((0, 0, 10, 10), 0.1, [(5, 5, 1, -1)], [([(1, 1), (2, 1), (2, 2)], 0)],
-                        [("velocity", (0.1, 0))])
-    problem = Problem(None, world, (0.5, 0.5, 0.0), (9, 9, 0.0), 0.5, 0.5, 1.0, 1.0, True)
+    # A metre square: its distance grid has the fewest cells (a tenth of a bundled scene's).
+    world = build_world((0, 0, 1, 1), 0.01, [(0.5, 0.5, 0.1, -1)],
+                        [([(0.1, 0.1), (0.2, 0.1), (0.2, 0.2)], 0)], [("velocity", (0.01, 0))])
+    problem = Problem(None, world, (0.05, 0.05, 0.0), (0.9, 0.9, 0.0), 0.05, 0.5, 0.1, 0.1, True)
     for name in PLANNERS:
         for steering in STEERINGS:
             p = Planner(problem, PlanOptions(planner=name, steering=steering))
