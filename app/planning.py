@@ -36,10 +36,12 @@ class TrackSource(BaseModel):
 
 
 def track_loader(track: TrackSource | None):
-    """``load_track(name)`` for `planner.compile_problem`: the uploaded track, else the library."""
-    import tracks
+    """``load_track(name)`` for `planner.compile_problem`: the uploaded track, else the library.
+    The tracks package (svgpathtools, SciPy's splines) loads only for a scenario with a track."""
 
     def load_track(name: str):
+        import tracks
+
         if track is not None and name == track.id:
             return tracks.load_track(track.svg, path_id=track.path, unit=track.unit,
                                      closed=track.closed)

@@ -1,4 +1,5 @@
-"""Start-up: commands that do not plan load no numba and no compiled kernel (issue 22)."""
+"""Start-up: commands that do not plan load no numba and no compiled kernel, and a plan without
+a track loads no track package (issue 22)."""
 
 import subprocess
 import sys
@@ -10,7 +11,7 @@ THESIS = Path(__file__).resolve().parents[1] / "tracks" / "library" / "thesis.sv
 # The CLI's entry point run as the `trackstar` script runs it; then which heavy modules loaded.
 CLI = ("import sys\nfrom app.cli import main\nsys.argv = ['trackstar', *sys.argv[1:]]\n"
        "try:\n    main()\nexcept SystemExit:\n    pass\n"
-       "print(sorted(m for m in ('numba', 'planner._kernel', 'planner._world') "
+       "print(sorted(m for m in ('numba', 'planner._kernel', 'planner._world', 'tracks') "
        "if m in sys.modules), file=sys.stderr)")
 
 
@@ -25,9 +26,11 @@ def loaded(*args: str) -> str:
     ["track", "inspect", str(THESIS)], ["track", "sample", str(THESIS)],
 ])
 def test_commands_that_do_not_plan_load_no_numba(args):
-    assert loaded(*args) == "[]"
+    modules = loaded(*args)
+    assert "numba" not in modules and "planner._" not in modules
 
 
-def test_a_plan_loads_the_kernels():
-    assert loaded("plan", "slalom", "--iterations", "1") == "['numba', 'planner._kernel', " \
-                                                           "'planner._world']"
+def test_a_plan_loads_the_kernels_and_tracks_only_for_a_track():
+    kernels = "'numba', 'planner._kernel', 'planner._world'"
+    assert loaded("plan", "slalom", "--iterations", "1") == f"[{kernels}]"
+    assert loaded("plan", "thesis_static", "--iterations", "1") == f"[{kernels}, 'tracks']"
