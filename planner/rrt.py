@@ -20,7 +20,7 @@ from planner._reroot import reroot
 from planner._rng import seed_state
 from planner._steer import steer_path
 from planner._world import inflated, path_clearances
-from planner.options import METRICS, PLANNERS, PlanOptions
+from planner.options import METRICS, PlanOptions
 from planner.problem import Problem, check_room
 from planner.steering import STEERINGS
 from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points, path_points
@@ -430,9 +430,10 @@ def warm_up() -> None:
     world = build_world((0, 0, 1, 1), 0.01, [(0.5, 0.5, 0.1, -1)],
                         [([(0.1, 0.1), (0.2, 0.1), (0.2, 0.2)], 0)], [("velocity", (0.01, 0))])
     problem = Problem(None, world, (0.05, 0.05, 0.0), (0.9, 0.9, 0.0), 0.05, 0.5, 0.1, 0.1, True)
-    for name in PLANNERS:
-        for steering in STEERINGS:
-            p = Planner(problem, PlanOptions(planner=name, steering=steering))
-            p.step(40)
-            p.result()
+    # One kernel serves every planner and steering (they are parameters, not types). Unsolved
+    # after 40 iterations: the path kernels load with a plan's first result, not with every
+    # process (a plan of one iteration, a worker's first job).
+    p = Planner(problem, PlanOptions(planner="rrtstar", steering="dubins"))
+    p.step(40)
+    p.result()
     _warm = True

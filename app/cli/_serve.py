@@ -13,14 +13,16 @@ import signal
 import socket
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 from urllib.parse import quote
 
 import typer
 
-from app.access import Access
 from app.cli._errors import InputError, user_errors
 from app.cli._warm import warm_kernels
+
+if TYPE_CHECKING:
+    from app.access import Access
 
 
 def _listen(host: str, port: int, what: str) -> socket.socket:
@@ -115,6 +117,7 @@ def serve(
     """Serve the REST API (/docs) and the browser studio; Ctrl-C stops both."""
     import platformdirs
 
+    from app.access import Access
     from app.server import ServerSettings, create_app
 
     with user_errors():

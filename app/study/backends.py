@@ -3,14 +3,12 @@
 Both take a task (a function and its arguments), hand back a handle, and say which handles are
 done; the driver alone stores results, so the database, CSV, report and resume behave the same
 on either. Scenario data travel with the tasks: a Ray node needs no shared file system.
+The pool's modules load with a pool: every command line names the backends.
 """
 
 from __future__ import annotations
 
 import os
-from concurrent.futures import FIRST_COMPLETED, wait
-
-from app.pool import start_pool, stop_pool
 
 __all__ = ["BACKENDS", "LocalBackend", "RayBackend", "open_backend"]
 
@@ -23,6 +21,8 @@ class LocalBackend:
         """This machine can always run its own pool."""
 
     def __init__(self, workers: int) -> None:
+        from app.pool import start_pool
+
         self.workers = workers
         self._pool = start_pool(workers)
 
@@ -30,12 +30,16 @@ class LocalBackend:
         return self._pool.submit(fn, *args)
 
     def finished(self, handles) -> list:
+        from concurrent.futures import FIRST_COMPLETED, wait
+
         return list(wait(handles, return_when=FIRST_COMPLETED)[0])
 
     def result(self, handle):
         return handle.result()
 
     def close(self) -> None:
+        from app.pool import stop_pool
+
         stop_pool(self._pool)
 
 
