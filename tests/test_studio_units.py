@@ -458,7 +458,8 @@ def test_pinned_runs_keep_their_colours_and_the_comparison_has_a_row_and_curves_
     finally:
         for worker in workers:
             worker.stop()
-    rrt, star = (Run(w.options, w.live.metrics, w.live.best_path, w.live.cost_over_time, 0.44)
+    rrt, star = (Run(w.options, w.live.metrics, w.live.best_path, w.live.cost_over_time,
+                     problem.scenario.vehicle)
                  for w in workers)
     assert rrt.label == "RRT, Dubins, seed 0" and len(rrt.path) and len(star.path)
 

@@ -233,7 +233,7 @@ class PlannerRun:
         live = self.worker.live
         path = live.best_path if live.best_path is not None else np.zeros((0, 6))
         return Run(self.worker.options, dict(live.metrics), path, list(live.cost_over_time),
-                   self.stage.parsed.vehicle.wheelbase)
+                   self.stage.parsed.vehicle)
 
     def compared(self) -> list[Run]:
         """The pinned runs, oldest first, and the current one."""

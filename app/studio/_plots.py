@@ -194,7 +194,7 @@ class Profiles:
         steer = (grid, _steer_deg(centre, self._wb), _steer_deg(pk, self._wb),
                  self._dmax * one, -self._dmax * one,
                  _shade(rev, self._dmax), marks,
-                 *(_steer_deg(k, r.wheelbase) for k, r in zip(pins, self._pins)))
+                 *(_steer_deg(k, r.vehicle.wheelbase) for k, r in zip(pins, self._pins)))
         return kappa, steer, self._speed(grid, path)
 
     def _speed(self, grid: np.ndarray, path: np.ndarray) -> tuple:
