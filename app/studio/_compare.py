@@ -24,7 +24,7 @@ from app.studio._scene import Z, arc_length, path_layers
 from planner.scenario import Vehicle
 
 __all__ = ["CURRENT", "MAX_PINS", "PALETTE", "Pins", "Run", "comparison_csv", "comparison_png",
-           "cost_curves"]
+           "cost_curves", "hex_rgb"]
 
 # Violet, teal, sienna, olive: none is a colour another line in the scene has (the tree's
 # blue, the path's pink, the rewire flashes' red and green, the centreline's blue, yellow and
@@ -167,7 +167,7 @@ class Pins:
             return
         self.scene.add_frame("/pins", show_axes=False)
         for i, run in enumerate(self.runs):
-            for suffix, seg, rgb, px in path_layers(run.path, _rgb(run.colour), marker,
+            for suffix, seg, rgb, px in path_layers(run.path, hex_rgb(run.colour), marker,
                                                     Z["pin"]):
                 if len(seg):
                     self.scene.add_line_segments(f"/pins/{i}{suffix}", seg, rgb,
@@ -187,7 +187,7 @@ def _swatch(colour: str) -> str:
     return f"<span style='color:{colour};font-weight:bold'>━━</span>"
 
 
-def _rgb(colour: str) -> tuple[int, int, int]:
+def hex_rgb(colour: str) -> tuple[int, int, int]:
     return tuple(int(colour[i:i + 2], 16) for i in (1, 3, 5))
 
 

@@ -10,7 +10,8 @@ like (Dubins: the bang-bang of arcs and straights).
 
 The x axis is shared arc length, so the centreline is cut to the stretch from the start to the
 goal — the part of the track the path is meant to follow. Pinned runs (_compare.py) add their
-curvature, steering and cost curves in their colours; the current run is the best path's pink.
+curvature, steering and cost curves in their colours, and their reverse stretches shaded
+lightly in them; the current run is the best path's pink.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import math
 import numpy as np
 
 import tracks
-from app.studio._compare import CURRENT, cost_curves
+from app.studio._compare import CURRENT, cost_curves, hex_rgb
 from app.studio._scene import arc_length, cusp_rows, reversing
 
 __all__ = ["Profiles"]
@@ -116,6 +117,12 @@ def _shade(rev: np.ndarray, limit: float) -> np.ndarray:
     return np.where(rev, SHADE * limit, -SHADE * limit)
 
 
+def _other_shade(run, limit: float) -> dict:
+    """A compared run's reverse shading (see `_shade`): its colour, light."""
+    return _series(f"{run.name} reverse", "rgba(0,0,0,0)", 0) | {
+        "fill": "rgba({},{},{},0.13)".format(*hex_rgb(run.colour)), "fillTo": -SHADE * limit}
+
+
 def _reverse_series(limit: float) -> tuple[dict, dict]:
     """The reverse shading (a fill from +limit down to −limit under reverse stretches, see
     `_shade`) and the cusps (points on the zero line), as uPlot series."""
@@ -177,8 +184,9 @@ class Profiles:
 
     def _profiles(self, path: np.ndarray) -> tuple[tuple, tuple, tuple]:
         """(curvature, steering data): x, centreline, path, +max, −max, the path's reverse
-        shading and cusps, each pin on one s grid as long as the longest path (with the
-        cusps' s in it); (speed data): x, the path's speed, its envelope, 0."""
+        shading and cusps, each pin's reverse shading, each pin, on one s grid as long as the
+        longest path (with the cusps' s in it); (speed data): x, the path's speed, its
+        envelope, 0."""
         paths = [path, *(r.path for r in self._pins)]
         end = max((arc_length(p)[-1] for p in paths if len(p) >= 2), default=self._goal_s)
         cusps = arc_length(path)[cusp_rows(path)]
@@ -189,11 +197,12 @@ class Profiles:
         one, rev = np.ones(len(grid)), _reverse_on(grid, path)
         marks = np.full(len(grid), math.nan)
         marks[list(self._cusps)] = 0.0
+        revs = [_reverse_on(grid, r.path) for r in self._pins]
         kappa = (grid, centre, pk, self._kmax * one, -self._kmax * one,
-                 _shade(rev, self._kmax), marks, *pins)
+                 _shade(rev, self._kmax), marks, *(_shade(r, self._kmax) for r in revs), *pins)
         steer = (grid, _steer_deg(centre, self._wb), _steer_deg(pk, self._wb),
                  self._dmax * one, -self._dmax * one,
-                 _shade(rev, self._dmax), marks,
+                 _shade(rev, self._dmax), marks, *(_shade(r, self._dmax) for r in revs),
                  *(_steer_deg(k, r.vehicle.wheelbase) for k, r in zip(pins, self._pins)))
         return kappa, steer, self._speed(grid, path)
 
@@ -219,13 +228,18 @@ class Profiles:
         self.speed.data = _for_uplot(speed)
 
     def _show_series(self) -> None:
-        """Each chart's series: its own, the cusps' points where they are now, the pins'."""
-        for h, base, symbol in zip((self.curvature, self.steering, self.cost), self._series,
-                                   (" κ", " δ", "")):
+        """Each chart's series: its own, the cusps' points where they are now, the pins'
+        reverse shading and curves."""
+        for h, base, symbol, limit in zip((self.curvature, self.steering, self.cost),
+                                          self._series, (" κ", " δ", ""),
+                                          (self._kmax, self._dmax, None)):
+            shades = ()
             if h is not self.cost:
                 cusp = base[6]
                 base = (*base[:6], cusp | {"points": cusp["points"] | {"filter": self._cusps}})
-            h.series = base + tuple(_series(r.name + symbol, r.colour, 1.5) for r in self._pins)
+                shades = tuple(_other_shade(r, limit) for r in self._pins)
+            h.series = base + shades + tuple(_series(r.name + symbol, r.colour, 1.5)
+                                             for r in self._pins)
 
     def show_cost(self, current) -> None:
         """The current run's (a `_compare.Run`) best cost against planning time and the pinned
