@@ -23,14 +23,17 @@ from app.studio._panel import PLANNERS, TIMINGS
 from app.studio._scene import Z, arc_length, path_layers
 from planner.scenario import Vehicle
 
-__all__ = ["CURRENT", "MAX_PINS", "PALETTE", "Pins", "Run", "comparison_csv", "comparison_png",
-           "cost_curves", "hex_rgb"]
+__all__ = ["CURRENT", "MAX_PINS", "PALETTE", "SPLIT_B", "Pins", "Run", "comparison_csv",
+           "comparison_png", "cost_curves", "hex_rgb", "settings_words"]
 
 # Violet, teal, sienna, olive: none is a colour another line in the scene has (the tree's
 # blue, the path's pink, the rewire flashes' red and green, the centreline's blue, yellow and
 # red, the step overlay's white, yellow and cyan), and each reads on the asphalt and on white.
 PALETTE = ("#9d4edd", "#00a89d", "#a0522d", "#808000")
 CURRENT = "#{:02x}{:02x}{:02x}".format(*PATH_RGB)  # the current run: the best path's pink
+# Run B of the two-up split (_split.py): a lime, apart from the pink, the pins' colours, the
+# tree's blue and the warm colours of obstacles, movers, goal and rewire flashes.
+SPLIT_B = "#78c800"
 MAX_PINS = len(PALETTE)  # a pin beyond these replaces the oldest
 COLUMNS = ("run", "colour", "planner", "steering", "seed", "timing", "iterations", "cost",
            "cost_unit", "length_m", "time_to_first_solution_s", "min_clearance_m",
@@ -62,9 +65,7 @@ class Run:
 
     @property
     def label(self) -> str:
-        o = self.options
-        words = [_PLANNER_LABELS[o.planner], planner.STEERINGS[o.steering].label, f"seed {o.seed}"]
-        return ", ".join(words + ([_TIMING_LABELS[o.timing]] if self.optimal else []))
+        return ", ".join(settings_words(self.options))
 
     @property
     def car(self) -> str:
@@ -114,6 +115,14 @@ class Run:
             "min_clearance_m": m.get("min_clearance_m"),
             "max_abs_curvature_per_m": np.abs(self.path[:, 3]).max() if solved else None,
             "waited_s": m.get("waited_s"), **_car_cells(self.vehicle)}
+
+
+def settings_words(options: planner.PlanOptions) -> list[str]:
+    """A run's settings as the panel names them: planner, steering, seed (and timing when it
+    is not constant speed)."""
+    o = options
+    words = [_PLANNER_LABELS[o.planner], planner.STEERINGS[o.steering].label, f"seed {o.seed}"]
+    return words + ([_TIMING_LABELS[o.timing]] if o.timing == "optimal" else [])
 
 
 def _car_cells(v: Vehicle) -> dict:
@@ -174,13 +183,15 @@ class Pins:
                                                  thickness=0.75 * px * scale,
                                                  thickness_units="screen")
 
-    def legend_html(self) -> str:
-        """Each pin's colour, settings, result and car, then the current run's colour."""
+    def legend_html(self, current: tuple = ((CURRENT, "this run"),)) -> str:
+        """Each pin's colour, settings, result and car, then the current runs' colours and
+        names (``current``: (colour, name) pairs; A and B in the split)."""
         rows = [f"{_swatch(r.colour)} <b>{r.name}</b>: {r.label} — {r.summary}<br>"
                 f"<span style='margin-left:2.2em;color:#777'>car: {html.escape(r.car)}</span>"
                 for r in self.runs]
         return ("<div style='font-size:12px;line-height:1.6'>"
-                + "<br>".join([*rows, f"{_swatch(CURRENT)} this run"]) + "</div>")
+                + "<br>".join([*rows, *(f"{_swatch(c)} {html.escape(name)}" for c, name in current)])
+                + "</div>")
 
 
 def _swatch(colour: str) -> str:

@@ -68,6 +68,7 @@ class Lane:
         self.tree.add_listener(self._on_events)
         self.record = TreeRecord(self.tree.root)  # what the replay slider rebuilds from
         self.stepped = 0  # iterations asked of each tree
+        self.wall = 0.0  # s of the worker's clock this run was going: planning, pace's sleeps
         self._result = self._timed_costs = None  # timing optimal: the result shown, and of what
         self._star = options.planner == "rrtstar"
         self._stepping = False
@@ -180,10 +181,10 @@ class Lane:
                 self._show_path(self._result.path)
         return self._result
 
-    def metrics(self, wall: float) -> dict:
-        """The metrics as the UI shows them; ``wall``: the seconds the worker's clock has run
-        (planning and the pace's sleeps), so iterations/s is the rate achieved."""
-        tree = self.tree
+    def metrics(self) -> dict:
+        """The metrics as the UI shows them: iterations/s over ``wall``, the rate achieved
+        (under the pace too, and beside the other run: both share one clock)."""
+        tree, wall = self.tree, self.wall
         out = {"iterations": tree.iterations, "nodes": tree.nodes, "rewires": tree.rewires,
                "time_to_first_solution_s": tree.time_to_first_solution_s,
                "cost": tree.best_cost,
@@ -212,7 +213,6 @@ class PlannerWorker:
         # Held while the runs' metrics are replaced and while the UI reads them: the numbers
         # it shows of A and B are of one moment of the clock.
         self.published = threading.Lock()
-        self._wall = 0.0  # s the runs took: planning and the pace's sleeps
         self._last_metrics = 0.0
         self._thread = threading.Thread(target=self._loop, daemon=True, name="planner")
         self._thread.start()
@@ -317,10 +317,12 @@ class PlannerWorker:
     def _advance(self, n: int, stepping: bool = False) -> float:
         """``n`` iterations of each run still going, one after the other."""
         t0 = time.perf_counter()
-        for lane in self._active():
+        active = self._active()
+        for lane in active:
             lane.advance(n, stepping)
         took = time.perf_counter() - t0
-        self._wall += took
+        for lane in active:
+            lane.wall += took
         return took
 
     def _throttle(self, pause: float) -> None:
@@ -328,7 +330,9 @@ class PlannerWorker:
         the rate achieved, not the planner's raw one."""
         t0 = time.perf_counter()
         time.sleep(max(0.0, pause))
-        self._wall += time.perf_counter() - t0
+        slept = time.perf_counter() - t0
+        for lane in self._active():
+            lane.wall += slept
 
     def _publish_metrics(self, force: bool = True) -> None:
         """Every run's metrics at once, after a whole batch: the runs' numbers are of one
@@ -336,7 +340,7 @@ class PlannerWorker:
         now = time.monotonic()
         if force or now - self._last_metrics >= METRICS_S:
             self._last_metrics = now
-            metrics = [lane.metrics(self._wall) for lane in self.lanes]
+            metrics = [lane.metrics() for lane in self.lanes]
             with self.published:
                 for lane, m in zip(self.lanes, metrics):
                     lane.live.metrics = m
