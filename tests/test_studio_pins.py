@@ -20,7 +20,7 @@ CAR = Vehicle(wheelbase=0.3, max_steer_deg=30.0, safety_margin=0.05,
               footprint={"type": "rectangle", "length": 0.4, "width": 0.2})
 
 
-def _reversing_path() -> np.ndarray:
+def reversing_path() -> np.ndarray:
     """Rows x, y, θ, κ, direction, t: 4 m forward along x, then 2 m back."""
     x = np.r_[np.linspace(0, 4, 41), np.linspace(3.9, 2, 20)]
     rows = np.zeros((len(x), 6))
@@ -32,7 +32,7 @@ def _pins(*cars) -> Pins:
     pins = Pins(SimpleNamespace(remove_by_name=lambda name: None))
     for car in cars:
         pins.add(Run(planner.PlanOptions(steering="reeds-shepp"), {"iterations": 10, "cost": 6.0},
-                     _reversing_path(), [], car))
+                     reversing_path(), [], car))
     return pins
 
 

@@ -2,22 +2,28 @@
 client as the tab) plans run B beside run A on one clock — after N steps both have done N
 iterations and hold the trees of same-seed planners stepped N times, B is drawn in a frame
 moved by the scene's width and a margin, the metrics, plots and comparison CSV name both, and
-leaving the split takes B away."""
+leaving the split takes B away; the profiles send a chart's data and series in the order
+viser's client needs."""
 
 from __future__ import annotations
 
 import csv
 import io
 import time
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 import planner
-from app.studio._compare import SPLIT_B, comparison_csv
+from app.raceline import raceline_limits
+from app.studio._compare import SPLIT_B, Run, comparison_csv
+from app.studio._plots import Profiles
 from app.studio._split import B_RGB, ROOT, offset
 from app.studio._tree import SEG
+from planner.scenario import Vehicle
 from tests._studio_tab import open_tab, wait
+from tests.test_studio_pins import reversing_path
 
 STEPS = 25
 
@@ -125,3 +131,50 @@ def test_split_runs_with_the_pace_on_one_clock_and_the_comparison_has_b(session)
     assert tuple(np.ravel(run._view_b._handles["best"].colors)[:3]) == B_RGB
     ui.split.value = False
 
+
+
+class _Chart:
+    """A uPlot handle that logs what is assigned to it ("data", "series"), in order."""
+
+    def __init__(self, data, series, **_) -> None:
+        self.log, self._data, self._series = [], data, series
+
+    @property
+    def data(self):
+        return self._data
+
+    @data.setter
+    def data(self, value) -> None:
+        self.log.append("data")
+        self._data = value
+
+    @property
+    def series(self):
+        return self._series
+
+    @series.setter
+    def series(self, value) -> None:
+        self.log.append("series")
+        self._series = value
+
+
+def test_a_chart_gets_its_data_before_new_series_of_the_same_number():
+    """viser's client rebuilds a chart whose series change and keeps its x zoom relative to
+    the data it had: series that arrive with a new x range left the split's profiles showing
+    0–45 m of a 9 m path. A cusp (new series, as many) goes after its data; a new run B (more
+    series) goes first, with the data that matches it."""
+    charts = []
+    gui = SimpleNamespace(add_uplot=lambda *a, **k: charts.append(_Chart(*a, **k)) or charts[-1],
+                          add_markdown=lambda content: SimpleNamespace(content=content))
+    profiles = Profiles(gui, np.linspace(0, 14, 50), np.zeros(50), 10.0, 0.44, 26.0,
+                        raceline_limits(vehicle=Vehicle()))
+    curvature = charts[0]
+    profiles.show_path(np.zeros((0, 6)))
+    curvature.log.clear()
+    profiles.show_path(reversing_path())  # a cusp: the points' filter changes
+    assert curvature.log == ["data", "series"]
+    b = Run(planner.PlanOptions(seed=2), {}, reversing_path(), [], Vehicle(), "B", SPLIT_B)
+    curvature.log.clear()
+    profiles.show_path(reversing_path(), b)
+    assert curvature.log == ["series", "data"]
+    assert len(curvature.series) == len(curvature.data)

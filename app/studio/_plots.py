@@ -230,10 +230,17 @@ class Profiles:
         """The current run's best path and, in the split, run B (a `_compare.Run`)."""
         self._path, self._split = path, split
         kappa, steer, speed = self._profiles(path)
-        self._sync_series()
+        # viser's client rebuilds a chart whose series change and keeps its x zoom relative
+        # to the data: a rebuild with a new x range keeps a stale one. While the series are
+        # as many, the data goes first, so that a rebuild finds its x range in place.
+        first = len(self.curvature.series) == len(kappa)
+        if not first:
+            self._sync_series()
         self.curvature.data = _for_uplot(kappa)
         self.steering.data = _for_uplot(steer)
         self.speed.data = _for_uplot(speed)
+        if first:
+            self._sync_series()
 
     def _sync_series(self) -> None:
         """The charts' series anew when the runs compared or the cusps (drawn by uPlot's
