@@ -14,10 +14,11 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from PIL import Image
 
 import planner
 from app.raceline import raceline_limits
-from app.studio._compare import SPLIT_B, Run, comparison_csv
+from app.studio._compare import SPLIT_B, Run, comparison_csv, comparison_png
 from app.studio._plots import Profiles
 from app.studio._split import B_RGB, ROOT, offset
 from app.studio._tree import SEG
@@ -128,6 +129,8 @@ def test_split_runs_with_the_pace_on_one_clock_and_the_comparison_has_b(session)
     assert [(r["run"], r["seed"], r["colour"]) for r in rows] == [
         ("A", "1", "#ff5ac8"), ("B", "2", SPLIT_B)]
     assert [int(r["iterations"]) for r in rows] == [400, 400]
+    png = comparison_png(run.compared(), "thesis: A and B")
+    assert Image.open(io.BytesIO(png)).size == (800, 900)
     assert tuple(np.ravel(run._view_b._handles["best"].colors)[:3]) == B_RGB
     ui.split.value = False
 
