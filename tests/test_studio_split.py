@@ -136,29 +136,12 @@ def test_split_runs_with_the_pace_on_one_clock_and_the_comparison_has_b(session)
 
 
 
-class _Chart:
+class _Chart(SimpleNamespace):
     """A uPlot handle that logs what is assigned to it ("data", "series"), in order."""
 
-    def __init__(self, data, series, **_) -> None:
-        self.log, self._data, self._series = [], data, series
-
-    @property
-    def data(self):
-        return self._data
-
-    @data.setter
-    def data(self, value) -> None:
-        self.log.append("data")
-        self._data = value
-
-    @property
-    def series(self):
-        return self._series
-
-    @series.setter
-    def series(self, value) -> None:
-        self.log.append("series")
-        self._series = value
+    def __setattr__(self, name: str, value) -> None:
+        self.log.append(name)
+        super().__setattr__(name, value)
 
 
 def test_a_chart_gets_its_data_before_new_series_of_the_same_number():
@@ -167,7 +150,8 @@ def test_a_chart_gets_its_data_before_new_series_of_the_same_number():
     0–45 m of a 9 m path. A cusp (new series, as many) goes after its data; a new run B (more
     series) goes first, with the data that matches it."""
     charts = []
-    gui = SimpleNamespace(add_uplot=lambda *a, **k: charts.append(_Chart(*a, **k)) or charts[-1],
+    gui = SimpleNamespace(add_uplot=lambda data, series, **k: charts.append(
+        _Chart(log=[], data=data, series=series)) or charts[-1],
                           add_markdown=lambda content: SimpleNamespace(content=content))
     profiles = Profiles(gui, np.linspace(0, 14, 50), np.zeros(50), 10.0, 0.44, 26.0,
                         raceline_limits(vehicle=Vehicle()))
