@@ -77,12 +77,16 @@ def test_split_steps_both_runs_on_one_clock_and_draws_b_beside_a(session):
     assert tuple(frame.position) == pytest.approx((offset(problem.bounds), 0.0, 0.0))
     assert offset(problem.bounds) > xmax - xmin
     b = lanes[1].live
-    assert wait(lambda: sum(len(h.points) for h in run._view_b._chunks.values())
+    assert wait(lambda: sum(len(h.points) for h in run.split.view._chunks.values())
                  == SEG * b.chunks.count)
-    drawn = np.concatenate([run._view_b._chunks[c].points for c in sorted(run._view_b._chunks)])
+    view = run.split.view
+    drawn = np.concatenate([view._chunks[c].points for c in sorted(view._chunks)])
     edges = b.chunks.points(b.chunks.count)
     assert np.allclose(drawn[:, 0, :2], edges[:, :-1].reshape(-1, 2))
-    assert all(h.name.startswith(f"{ROOT}/live/") for h in run._view_b._chunks.values())
+    assert all(h.name.startswith(f"{ROOT}/live/") for h in view._chunks.values())
+    x, y = b.chunks.get(1)[SEG // 2]  # a click on B's first edge, where it is drawn
+    assert run.split.pick(x + offset(problem.bounds), y) and view._handles["pick_l"].visible
+    assert not run.split.pick(x, y)  # in A's half: A's edge
     assert _node(session, f"{ROOT}/track/centre") is not None
     assert _node(session, "/split_a/title").text == "A: RRT* · Dubins · seed 1"
     assert _node(session, f"{ROOT}/title").text == "B: RRT* · Reeds-Shepp · seed 2"
@@ -93,7 +97,7 @@ def test_split_steps_both_runs_on_one_clock_and_draws_b_beside_a(session):
     assert ui.replay.disabled
 
     ui.split.value = False  # back to the single run
-    assert not run.splitting and run._view_b is None
+    assert not run.splitting and run.split.view is None
     assert _node(session, ROOT) is None and _node(session, "/split_a") is None
     assert run.view_bounds() == problem.bounds
     assert all("B" not in s["label"] for s in run._profiles.curvature.series)
@@ -131,7 +135,7 @@ def test_split_runs_with_the_pace_on_one_clock_and_the_comparison_has_b(session)
     assert [int(r["iterations"]) for r in rows] == [400, 400]
     png = comparison_png(run.compared(), "thesis: A and B")
     assert Image.open(io.BytesIO(png)).size == (800, 900)
-    assert tuple(np.ravel(run._view_b._handles["best"].colors)[:3]) == B_RGB
+    assert tuple(np.ravel(run.split.view._handles["best"].colors)[:3]) == B_RGB
     ui.split.value = False
 
 

@@ -26,8 +26,7 @@ from app.studio._panel import DEFAULT_BUDGET, PLANNERS, SPEEDS, STEERINGS, TIMIN
 from app.studio._plots import Profiles
 from app.studio._scenario import goal_fraction
 from app.studio._scene import draw_car, marker_size, yaw_wxyz
-from app.studio._split import B_RGB, Split, offset, split_bounds
-from app.studio._split import ROOT as SPLIT_ROOT
+from app.studio._split import Split
 from app.studio._tree import EdgeChunks
 from app.studio._worker import PlannerWorker
 from planner.validation import describe
@@ -46,8 +45,7 @@ class PlannerRun:
         self.worker: PlannerWorker | None = None
         self._driving = False  # the car shows the best path at the scene time
         self._view: LiveView | None = None
-        self._view_b: LiveView | None = None  # run B's, in the split
-        self.split = Split(scene)
+        self.split = Split(scene)  # run B's half of the scene
         self._choosing_b = False  # `choose_split` sets B's controls
         self.look = Look()  # how it draws the run (`set_look`)
         self._profiles: Profiles | None = None
@@ -61,7 +59,8 @@ class PlannerRun:
         """The stage cleared the scene (the run's drawing went with it): profile plots of the
         new track's centreline, for a vehicle of this size. Pins stay on the same track (a
         car's settings changed: they compare it with the car before)."""
-        self._view = self._view_b = self._car = None
+        self._view = self._car = None
+        self.split.forget()
         if self._profiles is not None:
             for h in self._profiles.handles:
                 h.remove()
@@ -134,17 +133,15 @@ class PlannerRun:
         """What the view fit frames: the scene, and B's half beside it in the split."""
         if self.stage.problem is None:
             return None
-        bounds = self.stage.problem.bounds
-        return split_bounds(bounds) if self.splitting else bounds
+        return self.split.bounds(self.stage.problem.bounds)
 
     def reset(self) -> None:
         """A fresh run of the stage's problem with the current settings (the old worker is
         stopped first)."""
         problem = self.stage.problem
         self.stop()
-        for view in (self._view, self._view_b):
-            if view is not None:
-                view.clear()
+        if self._view is not None:
+            self._view.clear()
         try:
             options = self.options()
             options.resolved(problem)  # refuses a robot this steering cannot drive
@@ -156,14 +153,12 @@ class PlannerRun:
                                     SPEEDS[self.ui.rate.value], other)
         camera = self.stage.client.camera
         self._view = LiveView(self.scene, self.worker.live, problem.bounds, self.look, camera)
-        self._view_b = None
         if other is None:
             self.split.hide()
         else:
             self.split.show(self.stage, tuple(f"{n}: {' · '.join(settings_words(o))}"
-                                              for n, o in (("A", options), ("B", other))))
-            self._view_b = LiveView(self.scene, self.worker.lanes[1].live, problem.bounds,
-                                    self.look, camera, f"{SPLIT_ROOT}/live", B_RGB)
+                                              for n, o in (("A", options), ("B", other))),
+                            self.worker.lanes[1].live, self.look, camera)
         self._shown = {"metrics": (), "best": (), "step": (), "cost": (), "replay": -1}
         self._old_edges.clear()
         self._driving = False
@@ -209,7 +204,7 @@ class PlannerRun:
     def set_look(self, look: Look) -> None:
         """Draw the run, now and from now on, with ``look`` (projector mode, a faded tree)."""
         self.look = look
-        for view in (self._view, self._view_b):
+        for view in (self._view, self.split.view):
             if view is not None:
                 view.restyle(look)
         self._draw_pins()
@@ -225,13 +220,7 @@ class PlannerRun:
     def pick(self, x: float, y: float) -> None:
         """A click on the ground at (x, y): the edge there says its word (`LiveView.pick`);
         in the split, right of the gap between the halves, run B's edge."""
-        if self._view is None:
-            return
-        bounds = self.stage.problem.bounds
-        dx = offset(bounds)
-        if self._view_b is not None and x > bounds[2] + 0.5 * (dx - bounds[2] + bounds[0]):
-            self._view_b.pick(x - dx, y)
-        else:
+        if self._view is not None and not self.split.pick(x, y):
             self._view.pick(x, y)
 
     # -- replay --------------------------------------------------------------------------------
@@ -410,7 +399,7 @@ class PlannerRun:
         if self._view is None:
             return
         lives = [lane.live for lane in self.worker.lanes]
-        for view in (self._view, self._view_b):
+        for view in (self._view, self.split.view):
             if view is not None:
                 view.tick()
         self._tick_replay(lives[0])
