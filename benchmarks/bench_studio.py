@@ -73,16 +73,16 @@ def _time_to(worker: PlannerWorker, nodes: int, marks: list[int], on_mark=None) 
     worker.run()
     t0 = time.monotonic()
     at = {}
-    while worker._run.nodes < nodes:
+    while worker.lanes[0].run.nodes < nodes:
         time.sleep(0.02)
         for m in marks:
-            if m not in at and worker._run.nodes >= m:
-                at[m] = (time.monotonic(), worker._run.iterations)
+            if m not in at and worker.lanes[0].run.nodes >= m:
+                at[m] = (time.monotonic(), worker.lanes[0].run.iterations)
                 if on_mark:
                     on_mark(m)
         if time.monotonic() - t0 > 300:
             raise RuntimeError("the planner did not reach the node count in 5 minutes")
-    at[nodes] = (time.monotonic(), worker._run.iterations)
+    at[nodes] = (time.monotonic(), worker.lanes[0].run.iterations)
     worker.pause()
     return {"start": t0, "marks": at}
 

@@ -5,20 +5,15 @@ the whole tree again at its end."""
 
 from __future__ import annotations
 
-import asyncio
-import threading
 import time
 
 import numpy as np
 import pytest
-import viser
-from websockets.asyncio.client import connect
 
 import planner
-from app.studio import launch
 from app.studio._replay import TreeRecord
 from app.studio._tree import CHUNK, SEG
-from tests.test_studio_sessions import CAMERA
+from tests._studio_tab import open_tab, wait
 
 OPTIONS = planner.PlanOptions(planner="rrtstar", seed=3)
 BATCH = 5  # iterations per step: several per batch, as the studio's worker steps
@@ -101,32 +96,15 @@ def _drawn_nodes(view) -> int:
 
 
 def test_the_slider_redraws_the_tree_of_an_earlier_iteration_and_goes_back_to_the_run():
-    studio = launch("127.0.0.1", 0, "http://127.0.0.1:9/api/v1")  # no API: none is called
-    closed = threading.Event()
-
-    async def tab() -> None:
-        async with connect(f"ws://127.0.0.1:{studio.port}/",
-                           subprotocols=[f"viser-v{viser.__version__}"]) as ws:
-            await ws.send(CAMERA)
-            while not closed.is_set():
-                try:
-                    await asyncio.wait_for(ws.recv(), 0.1)
-                except TimeoutError:
-                    pass
-
-    client = threading.Thread(target=asyncio.run, args=(tab(),), daemon=True)
-    client.start()
-    try:
-        assert _wait(lambda: studio.sessions)
-        session = next(iter(studio.sessions.values()))
+    with open_tab() as session:
         ui, run = session.ui, session.planning
         assert ui.replay.disabled  # nothing to replay yet
         ui.budget.value = 800  # a fresh run of 800 iterations
         run.resume("run")
-        assert _wait(lambda: run.worker.live.state == "done")
-        assert _wait(lambda: ui.replay.max == 800 and not ui.replay.disabled)
+        assert wait(lambda: run.worker.live.state == "done")
+        assert wait(lambda: ui.replay.max == 800 and not ui.replay.disabled)
         view = run._view
-        assert _wait(lambda: _drawn_nodes(view) == run.worker.live.chunks.count)
+        assert wait(lambda: _drawn_nodes(view) == run.worker.live.chunks.count)
         live_nodes = _drawn_nodes(view)
         assert ui.replay.value == 800 and "iteration 800 of 800" in ui.replay_note.content
 
@@ -148,14 +126,4 @@ def test_the_slider_redraws_the_tree_of_an_earlier_iteration_and_goes_back_to_th
         ui.replay.value = 800
         assert not view.replaying and _drawn_nodes(view) == live_nodes
         assert "(the run)" in ui.replay_note.content
-    finally:
-        closed.set()
-        client.join(timeout=5)
-        studio.stop()
 
-
-def _wait(condition, timeout: float = 60.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while not condition() and time.monotonic() < deadline:
-        time.sleep(0.02)
-    return bool(condition())

@@ -88,7 +88,8 @@ def test_a_pinned_path_shows_its_reverse_in_its_own_colour_dashed_on_white(parke
                             add_line_segments=lambda name, seg, rgb, **k: drawn.update(
                                 {name: (seg, rgb)}))
     pins = Pins(scene)
-    pins.add(Run(planner.PlanOptions(steering="reeds-shepp"), {}, live.best_path, [], 0.44))
+    pins.add(Run(planner.PlanOptions(steering="reeds-shepp"), {}, live.best_path, [],
+                 problem.scenario.vehicle))
     pins.draw(marker_size(problem.bounds))
     colour = tuple(int(pins.runs[0].colour[i:i + 2], 16) for i in (1, 3, 5))
     assert drawn["/pins/0"][1] == colour and drawn["/pins/0_reverse_dashes"][1] == colour

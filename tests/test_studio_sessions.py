@@ -9,19 +9,13 @@ import gc
 import threading
 import time
 
-import msgspec
 import pytest
 import viser
 from websockets.asyncio.client import connect
 
 from app.studio import launch
 from app.studio._session import Session
-
-# What viser's client sends once its canvas is up: the studio opens a session on it.
-CAMERA = msgspec.msgpack.encode({
-    "type": "ViewerCameraMessage", "wxyz": (1.0, 0.0, 0.0, 0.0), "position": (0.0, 0.0, 5.0),
-    "fov": 1.0, "near": 0.01, "far": 100.0, "image_height": 480, "image_width": 640,
-    "look_at": (0.0, 0.0, 0.0), "up_direction": (0.0, 0.0, 1.0)})
+from tests._studio_tab import CAMERA
 
 
 @pytest.fixture

@@ -194,7 +194,7 @@ def test_a_run_that_ends_between_metric_updates_still_shows_its_last_numbers():
         _run_to_the_end(worker)
         assert worker.live.state == "done"
         assert worker.live.metrics["iterations"] == 300
-        assert worker.live.metrics["nodes"] == worker._run.nodes > 2
+        assert worker.live.metrics["nodes"] == worker.lanes[0].run.nodes > 2
     finally:
         worker.stop()
 
@@ -212,7 +212,7 @@ def test_timing_optimal_shows_the_schedule_and_drive_car_stands_still_through_it
         path, m = worker.live.best_path, worker.live.metrics
     finally:
         worker.stop()
-    assert worker.live.error is None and worker._run.detour.iterations == 1500
+    assert worker.live.error is None and worker.lanes[0].run.detour.iterations == 1500
     assert m["waited_s"] > 10.0 and m["arrival_s"] == pytest.approx(path[-1, 5])
     assert f"| arrives after | {m['arrival_s']:.3g} s (waits {m['waited_s']:.3g} s) |" in (
         _metrics_md(m))
@@ -409,7 +409,7 @@ def test_step_until_a_rewire_stops_at_one_and_states_the_near_radius_it_used():
         deadline = time.monotonic() + 10
         while worker.live.step is None and time.monotonic() < deadline:
             time.sleep(0.01)
-        step, nodes = worker.live.step, worker._run.nodes
+        step, nodes = worker.live.step, worker.lanes[0].run.nodes
     finally:
         worker.stop()
     info = step["info"]
@@ -458,7 +458,8 @@ def test_pinned_runs_keep_their_colours_and_the_comparison_has_a_row_and_curves_
     finally:
         for worker in workers:
             worker.stop()
-    rrt, star = (Run(w.options, w.live.metrics, w.live.best_path, w.live.cost_over_time, 0.44)
+    rrt, star = (Run(w.options, w.live.metrics, w.live.best_path, w.live.cost_over_time,
+                     problem.scenario.vehicle)
                  for w in workers)
     assert rrt.label == "RRT, Dubins, seed 0" and len(rrt.path) and len(star.path)
 

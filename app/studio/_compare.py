@@ -10,6 +10,7 @@ draws their paths. The current run keeps the best path's pink everywhere.
 from __future__ import annotations
 
 import csv
+import html
 import io
 import math
 from dataclasses import dataclass, replace
@@ -20,19 +21,26 @@ import planner
 from app.studio._live_view import PATH_RGB
 from app.studio._panel import PLANNERS, TIMINGS
 from app.studio._scene import Z, arc_length, path_layers
+from planner.scenario import Vehicle
 
-__all__ = ["CURRENT", "MAX_PINS", "PALETTE", "Pins", "Run", "comparison_csv", "comparison_png",
-           "cost_curves"]
+__all__ = ["CURRENT", "MAX_PINS", "PALETTE", "SPLIT_B", "Pins", "Run", "comparison_csv",
+           "comparison_png", "cost_curves", "hex_rgb", "settings_words"]
 
 # Violet, teal, sienna, olive: none is a colour another line in the scene has (the tree's
 # blue, the path's pink, the rewire flashes' red and green, the centreline's blue, yellow and
 # red, the step overlay's white, yellow and cyan), and each reads on the asphalt and on white.
 PALETTE = ("#9d4edd", "#00a89d", "#a0522d", "#808000")
 CURRENT = "#{:02x}{:02x}{:02x}".format(*PATH_RGB)  # the current run: the best path's pink
+# Run B of the two-up split (_split.py): a lime, apart from the pink, the pins' colours, the
+# tree's blue and the warm colours of obstacles, movers, goal and rewire flashes.
+SPLIT_B = "#78c800"
 MAX_PINS = len(PALETTE)  # a pin beyond these replaces the oldest
 COLUMNS = ("run", "colour", "planner", "steering", "seed", "timing", "iterations", "cost",
            "cost_unit", "length_m", "time_to_first_solution_s", "min_clearance_m",
-           "max_abs_curvature_per_m", "waited_s")
+           "max_abs_curvature_per_m", "waited_s",
+           # the car it planned for (pins stay across Vehicle edits, to compare cars)
+           "wheelbase_m", "max_steer_deg", "turning_radius_m", "footprint", "disc_radius_m",
+           "car_length_m", "car_width_m", "safety_margin_m")
 _PLANNER_LABELS = {v: k for k, v in PLANNERS.items()}
 _TIMING_LABELS = {v: k for k, v in TIMINGS.items()}
 
@@ -40,13 +48,14 @@ _TIMING_LABELS = {v: k for k, v in TIMINGS.items()}
 @dataclass(frozen=True)
 class Run:
     """One run as compared: its settings, its last metrics, its best path (rows x, y, θ, κ,
-    direction, t) and its best cost over planning time; ``wheelbase`` turns κ into steering."""
+    direction, t), its best cost over planning time and the car it planned for (whose
+    wheelbase turns κ into steering)."""
 
     options: planner.PlanOptions
     metrics: dict
     path: np.ndarray
     cost_over_time: list
-    wheelbase: float
+    vehicle: Vehicle
     name: str = "this run"
     colour: str = CURRENT
 
@@ -56,9 +65,16 @@ class Run:
 
     @property
     def label(self) -> str:
-        o = self.options
-        words = [_PLANNER_LABELS[o.planner], planner.STEERINGS[o.steering].label, f"seed {o.seed}"]
-        return ", ".join(words + ([_TIMING_LABELS[o.timing]] if self.optimal else []))
+        return ", ".join(settings_words(self.options))
+
+    @property
+    def car(self) -> str:
+        """The car in short, for the legend: "wheelbase 0.44 m, δmax 26°, disc r 0.1 m"."""
+        v, fp = self.vehicle, self.vehicle.footprint
+        shape = (f"{fp.length:g} × {fp.width:g} m" if fp is not None
+                 else f"disc r {v.radius:g} m" if v.radius > 0 else "point")
+        margin = f", margin {v.safety_margin:g} m" if v.safety_margin > 0 else ""
+        return f"wheelbase {v.wheelbase:g} m, δmax {v.max_steer_deg:g}°, {shape}{margin}"
 
     @property
     def cost(self) -> float | None:
@@ -74,7 +90,7 @@ class Run:
         return f"{cost}, {self.metrics.get('iterations', 0)} iterations"
 
     def steering_deg(self) -> np.ndarray:
-        return np.degrees(np.arctan(self.wheelbase * self.path[:, 3]))
+        return np.degrees(np.arctan(self.vehicle.wheelbase * self.path[:, 3]))
 
     def cost_curve(self) -> tuple[np.ndarray, np.ndarray]:
         """(planning time, best cost) at each improvement, the last held to the planning time
@@ -98,7 +114,27 @@ class Run:
             "time_to_first_solution_s": m.get("time_to_first_solution_s"),
             "min_clearance_m": m.get("min_clearance_m"),
             "max_abs_curvature_per_m": np.abs(self.path[:, 3]).max() if solved else None,
-            "waited_s": m.get("waited_s")}
+            "waited_s": m.get("waited_s"), **_car_cells(self.vehicle)}
+
+
+def settings_words(options: planner.PlanOptions) -> list[str]:
+    """A run's settings as the panel names them: planner, steering, seed (and timing when it
+    is not constant speed)."""
+    o = options
+    words = [_PLANNER_LABELS[o.planner], planner.STEERINGS[o.steering].label, f"seed {o.seed}"]
+    return words + ([_TIMING_LABELS[o.timing]] if o.timing == "optimal" else [])
+
+
+def _car_cells(v: Vehicle) -> dict:
+    """The car's columns of the comparison CSV."""
+    fp = v.footprint
+    return {"wheelbase_m": v.wheelbase, "max_steer_deg": v.max_steer_deg,
+            "turning_radius_m": v.turning_radius,
+            "footprint": "rectangle" if fp is not None else "disc" if v.radius > 0 else "point",
+            "disc_radius_m": v.radius if fp is None else None,
+            "car_length_m": fp.length if fp is not None else None,
+            "car_width_m": fp.width if fp is not None else None,
+            "safety_margin_m": v.safety_margin}
 
 
 def cost_curves(runs: list[Run]) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -140,26 +176,29 @@ class Pins:
             return
         self.scene.add_frame("/pins", show_axes=False)
         for i, run in enumerate(self.runs):
-            for suffix, seg, rgb, px in path_layers(run.path, _rgb(run.colour), marker,
+            for suffix, seg, rgb, px in path_layers(run.path, hex_rgb(run.colour), marker,
                                                     Z["pin"]):
                 if len(seg):
                     self.scene.add_line_segments(f"/pins/{i}{suffix}", seg, rgb,
                                                  thickness=0.75 * px * scale,
                                                  thickness_units="screen")
 
-    def legend_html(self) -> str:
-        """Each pin's colour, settings and result, then the current run's colour."""
-        rows = [f"{_swatch(r.colour)} <b>{r.name}</b>: {r.label} — {r.summary}"
+    def legend_html(self, current: tuple = ((CURRENT, "this run"),)) -> str:
+        """Each pin's colour, settings, result and car, then the current runs' colours and
+        names (``current``: (colour, name) pairs; A and B in the split)."""
+        rows = [f"{_swatch(r.colour)} <b>{r.name}</b>: {r.label} — {r.summary}<br>"
+                f"<span style='margin-left:2.2em;color:#777'>car: {html.escape(r.car)}</span>"
                 for r in self.runs]
         return ("<div style='font-size:12px;line-height:1.6'>"
-                + "<br>".join([*rows, f"{_swatch(CURRENT)} this run"]) + "</div>")
+                + "<br>".join([*rows, *(f"{_swatch(c)} {html.escape(name)}" for c, name in current)])
+                + "</div>")
 
 
 def _swatch(colour: str) -> str:
     return f"<span style='color:{colour};font-weight:bold'>━━</span>"
 
 
-def _rgb(colour: str) -> tuple[int, int, int]:
+def hex_rgb(colour: str) -> tuple[int, int, int]:
     return tuple(int(colour[i:i + 2], 16) for i in (1, 3, 5))
 
 

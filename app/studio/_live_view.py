@@ -193,10 +193,14 @@ def edge_label(kinds: np.ndarray, lens: np.ndarray, place: str) -> str:
 class LiveView:
     """One run's drawing in one client's scene; `clear` removes all of it."""
 
-    def __init__(self, scene, live: Live, bounds, look: Look = Look(), camera=None) -> None:
+    def __init__(self, scene, live: Live, bounds, look: Look = Look(), camera=None,
+                 root: str = "/live", path_rgb=PATH_RGB) -> None:
         """``bounds``: the scene's (xmin, ymin, xmax, ymax), which sizes the markers;
-        ``camera``: the client's, whose view sizes the step labels."""
+        ``camera``: the client's, whose view sizes the step labels; ``root``: the scene node
+        it draws under (the split's second run: in a frame moved beside the first);
+        ``path_rgb``: its best path's colour."""
         self.scene, self.live, self.bounds, self.look = scene, live, bounds, look
+        self.root, self.path_rgb = root, path_rgb
         self.camera = camera
         self.marker = marker_size(bounds)
         self._chunks: dict[int, object] = {}
@@ -228,7 +232,7 @@ class LiveView:
         if h is None:
             self._px[name] = px
             self._handles[name] = self.scene.add_line_segments(
-                f"/live/{name}", seg, rgb, thickness=px * self.look.scale,
+                f"{self.root}/{name}", seg, rgb, thickness=px * self.look.scale,
                 thickness_units="screen")
         else:
             h.points = seg
@@ -259,7 +263,7 @@ class LiveView:
             h = self._chunks.get(c)
             if h is None:
                 self._chunks[c] = self.scene.add_line_segments(
-                    f"/live/tree/c{c}", seg, self.look.tree_rgb,
+                    f"{self.root}/tree/c{c}", seg, self.look.tree_rgb,
                     thickness=TREE_PX * self.look.scale, thickness_units="screen")
             else:
                 h.points = seg
@@ -274,7 +278,7 @@ class LiveView:
                 if name.startswith("best"):
                     h.visible = False
             return
-        for suffix, seg, rgb, px in path_layers(path, PATH_RGB, self.marker, Z["path"]):
+        for suffix, seg, rgb, px in path_layers(path, self.path_rgb, self.marker, Z["path"]):
             self._put(f"best{suffix}", seg, rgb, px)
 
     def replay(self, edges: EdgeChunks, path: np.ndarray | None) -> None:
@@ -348,7 +352,7 @@ class LiveView:
         h = self._handles.get(name)
         pos = (*where, Z["step"])
         if h is None:
-            self._handles[name] = self.scene.add_label(f"/live/{name}", text, position=pos,
+            self._handles[name] = self.scene.add_label(f"{self.root}/{name}", text, position=pos,
                                                        anchor=anchor,
                                                        font_screen_scale=self.look.scale)
         else:

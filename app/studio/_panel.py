@@ -66,6 +66,10 @@ class Panel:
     budget: object
     seed: object
     rate: object
+    split: object  # the two-up split (issue 20): run B beside A, its settings
+    b_planner: object
+    b_steering: object
+    b_seed: object
     run: object
     pause: object
     step: object
@@ -170,6 +174,14 @@ def build_panel(gui) -> Panel:
         seed = gui.add_number("Seed", 0, min=0, step=1)
         rate = gui.add_dropdown("Pace (it/s)", tuple(SPEEDS), initial_value="max",
                                 hint="Slows the planner down to watch the tree grow")
+        with gui.add_folder("Two-up split (A | B)", expand_by_default=False):
+            split = gui.add_checkbox(
+                "Split: run B beside A", False,
+                hint="A second run on the same scenario, drawn to the right of this one (A); "
+                     "Run, Pause, Step and the pace drive both, iteration for iteration")
+            b_planner = gui.add_dropdown("B: planner", tuple(PLANNERS), initial_value="RRT")
+            b_steering = gui.add_dropdown("B: steering", tuple(STEERINGS))
+            b_seed = gui.add_number("B: seed", 0, min=0, step=1)
         run = gui.add_button("Run")
         pause = gui.add_button("Pause")
         step = gui.add_button("Step")

@@ -1,6 +1,7 @@
 """The planner's run in one tab and everything that shows it: the worker, its live drawing, the
 profile plots, the `Status`, `Metrics` and `EXTEND` panels, the car that drives the best path
-(`Drive car`) and the pinned runs it is compared with.
+(`Drive car`), the pinned runs it is compared with and the two-up split (a run B beside it, on
+the same clock: `Split`, _split.py).
 
 `PlannerRun` is the only writer of those; it plans the stage's current problem, and any change
 of scenario or planner setting starts a fresh run (`reset`): the old tree belongs to the old one.
@@ -18,19 +19,21 @@ from pydantic import ValidationError
 import planner
 import tracks
 from app.raceline import path_raceline, raceline_limits
-from app.studio._compare import Pins, Run
+from app.studio._compare import CURRENT, SPLIT_B, Pins, Run, settings_words
 from app.studio._extend import FIRST_NOTE, explain, near_note, render, until_note
 from app.studio._live_view import LiveView, Look
 from app.studio._panel import DEFAULT_BUDGET, PLANNERS, SPEEDS, STEERINGS, TIMINGS
 from app.studio._plots import Profiles
 from app.studio._scenario import goal_fraction
 from app.studio._scene import draw_car, marker_size, yaw_wxyz
+from app.studio._split import Split
 from app.studio._tree import EdgeChunks
 from app.studio._worker import PlannerWorker
 from planner.validation import describe
 
 __all__ = ["PlannerRun", "pose_at_time"]
 
+SPLIT_REPLAY = "Replay: one run at a time (leave the split to replay)"
 PLOT_S = 1.0  # profile plots redraw at most this often (uPlot re-renders all of it)
 OLD_EDGES = 300_000  # replayed edges a tree no longer holds, kept at most (a few 10 MB)
 
@@ -42,6 +45,8 @@ class PlannerRun:
         self.worker: PlannerWorker | None = None
         self._driving = False  # the car shows the best path at the scene time
         self._view: LiveView | None = None
+        self.split = Split(scene)  # run B's half of the scene
+        self._choosing_b = False  # `choose_split` sets B's controls
         self.look = Look()  # how it draws the run (`set_look`)
         self._profiles: Profiles | None = None
         self._car = None
@@ -54,7 +59,8 @@ class PlannerRun:
         """The stage cleared the scene (the run's drawing went with it): profile plots of the
         new track's centreline, for a vehicle of this size. Pins stay on the same track (a
         car's settings changed: they compare it with the car before)."""
-        self._view, self._car = None, None
+        self._view = self._car = None
+        self.split.forget()
         if self._profiles is not None:
             for h in self._profiles.handles:
                 h.remove()
@@ -84,6 +90,51 @@ class PlannerRun:
         except ValidationError as exc:
             raise ValueError(describe(exc).replace("iterations:", "Budget:")) from None
 
+    def _options_b(self, a: planner.PlanOptions, problem) -> planner.PlanOptions | None:
+        """Run B's options in the split (A's, with B's planner, steering and seed); None
+        outside it. A steering this robot cannot drive is refused: B then plans as A."""
+        u = self.ui
+        if not u.split.value:
+            return None
+        b = a.model_copy(update={"planner": PLANNERS[u.b_planner.value],
+                                 "steering": STEERINGS[u.b_steering.value],
+                                 "seed": int(u.b_seed.value)})
+        try:
+            b.resolved(problem)
+        except ValueError as exc:
+            self.notify("Run B's options", str(exc))
+            return a
+        return b
+
+    @property
+    def splitting(self) -> bool:
+        """Whether the run is the two-up split (A and B)."""
+        return self.worker is not None and len(self.worker.lanes) > 1
+
+    def choose_split(self) -> None:
+        """`Split` ticked: B starts as the other planner of A with A's steering and seed (one
+        reset for the three, see `b_changed`)."""
+        u = self.ui
+        if u.split.value:
+            self._choosing_b = True
+            try:
+                u.b_planner.value = next(k for k in PLANNERS if k != u.planner_name.value)
+                u.b_steering.value, u.b_seed.value = u.steering.value, u.seed.value
+            finally:
+                self._choosing_b = False
+        self.reset()
+
+    def b_changed(self) -> None:
+        """Run B's planner, steering or seed edited: a fresh split (none outside it)."""
+        if self.ui.split.value and not self._choosing_b:
+            self.reset()
+
+    def view_bounds(self):
+        """What the view fit frames: the scene, and B's half beside it in the split."""
+        if self.stage.problem is None:
+            return None
+        return self.split.bounds(self.stage.problem.bounds)
+
     def reset(self) -> None:
         """A fresh run of the stage's problem with the current settings (the old worker is
         stopped first)."""
@@ -97,11 +148,18 @@ class PlannerRun:
         except ValueError as exc:
             self.notify("Planner options", str(exc))
             options = planner.PlanOptions(iterations=DEFAULT_BUDGET)
+        other = self._options_b(options, problem)
         self.worker = PlannerWorker(problem, options, options.iterations,
-                                    SPEEDS[self.ui.rate.value])
-        self._view = LiveView(self.scene, self.worker.live, problem.bounds, self.look,
-                              self.stage.client.camera)
-        self._shown = {"metrics": -1, "best": 0, "step": 0, "cost": 0, "replay": -1}
+                                    SPEEDS[self.ui.rate.value], other)
+        camera = self.stage.client.camera
+        self._view = LiveView(self.scene, self.worker.live, problem.bounds, self.look, camera)
+        if other is None:
+            self.split.hide()
+        else:
+            self.split.show(self.stage, tuple(f"{n}: {' · '.join(settings_words(o))}"
+                                              for n, o in (("A", options), ("B", other))),
+                            self.worker.lanes[1].live, self.look, camera)
+        self._shown = {"metrics": (), "best": (), "step": (), "cost": (), "replay": -1}
         self._old_edges.clear()
         self._driving = False
         if self._car is not None:
@@ -109,10 +167,11 @@ class PlannerRun:
             self._car = None
         self.ui.metrics.content = "—"
         self.ui.extend.content = render(None, FIRST_NOTE)
+        self._show_pins_legend()
         if self._profiles is not None:
             self._profiles.set_steering(options.steering)
-            self._profiles.show_path(np.zeros((0, 4)))
-            self._profiles.show_cost(self.current())
+            self._profiles.show_path(np.zeros((0, 4)), self.current_b())
+            self._profiles.show_cost(*self._compared_now())
 
     def stop(self) -> None:
         if self.worker is not None:
@@ -130,7 +189,8 @@ class PlannerRun:
 
     def step(self, until: str) -> None:
         """`Step until a node is added` ("node") or `Step until a rewire` ("rewire")."""
-        if until == "rewire" and self.ui.planner_name.value != "RRT*":
+        if until == "rewire" and all(lane.options.planner == "rrt"
+                                     for lane in self.worker.lanes):
             self.notify("RRT never rewires", "choose the planner RRT* to see rewires")
             return
         self.replay_end()
@@ -144,8 +204,9 @@ class PlannerRun:
     def set_look(self, look: Look) -> None:
         """Draw the run, now and from now on, with ``look`` (projector mode, a faded tree)."""
         self.look = look
-        if self._view is not None:
-            self._view.restyle(look)
+        for view in (self._view, self.split.view):
+            if view is not None:
+                view.restyle(look)
         self._draw_pins()
 
     def raceline(self) -> str | None:
@@ -157,15 +218,17 @@ class PlannerRun:
         return path_raceline(path, raceline_limits(vehicle=self.stage.parsed.vehicle))
 
     def pick(self, x: float, y: float) -> None:
-        """A click on the ground at (x, y): the edge there says its word (`LiveView.pick`)."""
-        if self._view is not None:
+        """A click on the ground at (x, y): the edge there says its word (`LiveView.pick`);
+        in the split, right of the gap between the halves, run B's edge."""
+        if self._view is not None and not self.split.pick(x, y):
             self._view.pick(x, y)
 
     # -- replay --------------------------------------------------------------------------------
     def replay(self, n: int) -> None:
         """The replay slider at iteration n: the tree and the best path as they stood then, on
-        a paused or finished run (the worker's `TreeRecord`); at its last iteration, the run."""
-        if self._view is None or self.worker.live.state == "running":
+        a paused or finished run (the worker's `TreeRecord`); at its last iteration, the run.
+        Not in the split (the slider is disabled there)."""
+        if self._view is None or self.worker.live.state == "running" or self.splitting:
             return
         record = self.worker.record
         if n >= record.iterations:
@@ -214,15 +277,16 @@ class PlannerRun:
         """The slider follows the record: usable once the run is paused or done, at its end
         while the run is shown."""
         slider, end = self.ui.replay, self.worker.record.iterations
-        idle = live.state != "running"
-        if slider.disabled == (idle and end > 0):
-            slider.disabled = not (idle and end > 0)
+        usable = live.state != "running" and end > 0 and not self.splitting
+        if slider.disabled == usable:
+            slider.disabled = not usable
         if self._view.replaying or self._shown["replay"] == end:
             return
         self._shown["replay"] = end
         slider.max = max(end, 1)
         slider.value = end
-        self.ui.replay_note.content = _replay_md(None, self.worker.record)
+        self.ui.replay_note.content = (SPLIT_REPLAY if self.splitting
+                                       else _replay_md(None, self.worker.record))
 
     # -- compare runs --------------------------------------------------------------------------
     def current(self) -> Run | None:
@@ -230,14 +294,30 @@ class PlannerRun:
         most 0.5 s behind a running planner); None before the first run."""
         if self.worker is None:
             return None
-        live = self.worker.live
+        return self._run_of(0, "A" if self.splitting else "this run", CURRENT)
+
+    def current_b(self) -> Run | None:
+        """Run B of the split, as compared (None outside it)."""
+        return self._run_of(1, "B", SPLIT_B) if self.splitting else None
+
+    def _run_of(self, lane: int, name: str, colour: str) -> Run:
+        lane = self.worker.lanes[lane]
+        live = lane.live
         path = live.best_path if live.best_path is not None else np.zeros((0, 6))
-        return Run(self.worker.options, dict(live.metrics), path, list(live.cost_over_time),
-                   self.stage.parsed.vehicle.wheelbase)
+        return Run(lane.options, dict(live.metrics), path, list(live.cost_over_time),
+                   self.stage.parsed.vehicle, name, colour)
+
+    def _compared_now(self) -> tuple[Run | None, Run | None]:
+        """The current run and run B (None outside the split) with metrics of one moment."""
+        if self.worker is None:
+            return None, None
+        with self.worker.published:
+            return self.current(), self.current_b()
 
     def compared(self) -> list[Run]:
-        """The pinned runs, oldest first, and the current one."""
-        return [*self.pins.runs, self.current()]
+        """The pinned runs, oldest first, the current one and, in the split, run B."""
+        a, b = self._compared_now()
+        return [*self.pins.runs, a, *([b] if b is not None else [])]
 
     def pin(self) -> None:
         """`Pin this run`: its best path, profiles and cost over time stay drawn in a colour of
@@ -263,9 +343,16 @@ class PlannerRun:
 
     def _show_pins(self) -> None:
         self._draw_pins()
-        self.ui.pins_legend.content = self.pins.legend_html()
-        self.ui.pins_legend.visible = bool(self.pins.runs)
+        self._show_pins_legend()
         self._profiles.set_pins(self.pins.runs)
+
+    def _show_pins_legend(self) -> None:
+        """The pins' legend, ending with the current run's colour (A's and B's in the
+        split)."""
+        current = ((CURRENT, "this run"),) if not self.splitting else tuple(
+            (r.colour, f"{r.name}: {r.label}") for r in (self.current(), self.current_b()))
+        self.ui.pins_legend.content = self.pins.legend_html(current)
+        self.ui.pins_legend.visible = bool(self.pins.runs)
 
     # -- the car -------------------------------------------------------------------------------
     def drive(self) -> None:
@@ -287,6 +374,12 @@ class PlannerRun:
         path = self.worker.live.best_path if self._driving else None
         return float(path[-1, 5]) if path is not None and len(path) else None
 
+    def show_time(self, t: float) -> None:
+        """The scene clock at t: run B's moving obstacles (the stage moves A's) and the driving
+        car."""
+        self.split.show_time(t)
+        self.show_car(t)
+
     def show_car(self, t: float) -> None:
         """The driving car where the best path is at time t."""
         path = self.worker.live.best_path if self.worker is not None else None
@@ -305,34 +398,56 @@ class PlannerRun:
         """Draw the worker's progress and update the panels with what changed."""
         if self._view is None:
             return
-        live = self.worker.live
-        self._view.tick()
-        self._tick_replay(live)
-        status = f"Status: **{live.state}**" + (f" — {live.error}" if live.error else "")
+        lives = [lane.live for lane in self.worker.lanes]
+        for view in (self._view, self.split.view):
+            if view is not None:
+                view.tick()
+        self._tick_replay(lives[0])
+        status = "Status: " + ", ".join(
+            (f"{name} " if len(lives) > 1 else "") + f"**{live.state}**"
+            + (f" — {live.error}" if live.error else "") for name, live in zip("AB", lives))
         if status != self.ui.status.content:  # GUI updates re-render the panel: only changes
             self.ui.status.content = status
-        if live.metrics_version != self._shown["metrics"]:
-            self._shown["metrics"] = live.metrics_version
-            self.ui.metrics.content = _metrics_md(live.metrics)
+        with self.worker.published:
+            versions = tuple(live.metrics_version for live in lives)
+            metrics = [live.metrics for live in lives]
+        if versions != self._shown["metrics"]:
+            self._shown["metrics"] = versions
+            self.ui.metrics.content = _metrics_md(*metrics)
         if time.monotonic() - self._shown.get("plotted", 0.0) > PLOT_S:
-            self._plot(live)
-        if live.step_version != self._shown["step"] and live.step is not None:
-            self._shown["step"] = live.step_version
-            step = live.step
-            line, note = explain(step["info"], step["star"])
-            self.ui.extend.content = render(line, until_note(*step["until"]),
-                                            f"Iteration {step['info'].iteration}: {note}",
-                                            near_note(step["info"], step["options"]))
+            self._plot(lives)
+        steps = tuple(live.step_version for live in lives)
+        if steps != self._shown["step"] and lives[0].step is not None:
+            self._shown["step"] = steps
+            self.ui.extend.content = _extend_html([live.step for live in lives])
 
-    def _plot(self, live) -> None:
-        """The profiles when the best path changed, the cost curve when the metrics did (it
-        runs on to the planning time so far)."""
-        if live.best_version != self._shown["best"] and live.best_path is not None:
-            self._shown["best"], self._shown["plotted"] = live.best_version, time.monotonic()
-            self._profiles.show_path(live.best_path)
-        if live.metrics_version != self._shown["cost"]:
-            self._shown["cost"], self._shown["plotted"] = live.metrics_version, time.monotonic()
-            self._profiles.show_cost(self.current())
+    def _plot(self, lives: list) -> None:
+        """The profiles when a best path changed, the cost curves when the metrics did (they
+        run on to the planning time so far); run B's too in the split."""
+        now = time.monotonic()
+        paths = tuple(live.best_version for live in lives)
+        if paths != self._shown["best"]:
+            self._shown["best"], self._shown["plotted"] = paths, now
+            path = lives[0].best_path
+            self._profiles.show_path(path if path is not None else np.zeros((0, 4)),
+                                     self.current_b())
+        costs = tuple(live.metrics_version for live in lives)
+        if costs != self._shown["cost"]:
+            self._shown["cost"], self._shown["plotted"] = costs, now
+            self._profiles.show_cost(*self._compared_now())
+
+
+def _extend_html(steps: list) -> str:
+    """The EXTEND panel after a step: run A's line highlighted and explained; in the split, a
+    line more on what run B's same iteration did."""
+    step = steps[0]
+    line, note = explain(step["info"], step["star"])
+    notes = [until_note(*step["until"]), f"Iteration {step['info'].iteration}: {note}",
+             near_note(step["info"], step["options"])]
+    if len(steps) > 1 and steps[1] is not None:
+        notes.append(f"B, its iteration {steps[1]['info'].iteration}: "
+                     f"{explain(steps[1]['info'], steps[1]['star'])[1]}")
+    return render(line, *notes)
 
 
 def pose_at_time(path: np.ndarray, t: float) -> tuple[float, float, float]:
@@ -366,18 +481,27 @@ def _fmt(v, unit: str = "", digits: int = 3) -> str:
     return f"{v:.{digits}g}{unit}" if isinstance(v, float) else f"{v}{unit}"
 
 
-def _metrics_md(m: dict) -> str:
+def _metric_cells(m: dict) -> dict[str, str]:
+    """One run's column of the metrics table, by row name."""
     if not m:
+        return {}
+    arrival = {} if m.get("arrival_s") is None else {  # timing optimal, once solved
+        "arrives after": f"{_fmt(m['arrival_s'], ' s')} (waits {_fmt(m['waited_s'], ' s')})"}
+    return {"iterations": f"{m['iterations']}", "nodes": f"{m['nodes']}",
+            "rewires": f"{m['rewires']}",
+            "time to first solution": _fmt(m["time_to_first_solution_s"], " s"),
+            "cost": _fmt(m["cost"], " m", 4), **arrival,
+            "min clearance": _fmt(m["min_clearance_m"], " m"),
+            "iterations/s": _fmt(m["iterations_per_s"], "", 4)}
+
+
+def _metrics_md(*runs: dict) -> str:
+    """The metrics table: a column per run, headed A and B in the split."""
+    cols = [_metric_cells(m) for m in runs]
+    if not any(cols):
         return "—"
-    arrival = [] if m.get("arrival_s") is None else [  # timing optimal, once solved
-        f"| arrives after | {_fmt(m['arrival_s'], ' s')} (waits {_fmt(m['waited_s'], ' s')}) |"]
-    return "\n".join([
-        f"| iterations | {m['iterations']} |", "|---|---|",
-        f"| nodes | {m['nodes']} |",
-        f"| rewires | {m['rewires']} |",
-        f"| time to first solution | {_fmt(m['time_to_first_solution_s'], ' s')} |",
-        f"| cost | {_fmt(m['cost'], ' m', 4)} |",
-        *arrival,
-        f"| min clearance | {_fmt(m['min_clearance_m'], ' m')} |",
-        f"| iterations/s | {_fmt(m['iterations_per_s'], '', 4)} |",
-    ])
+    rows = [f"| {k} | " + " | ".join(c.get(k, "—") for c in cols) + " |"
+            for k in dict.fromkeys(k for c in cols for k in c)]
+    if len(cols) == 1:  # the first row heads the table
+        return "\n".join([rows[0], "|---|---|", *rows[1:]])
+    return "\n".join(["| | A | B |", "|---|---|---|", *rows])

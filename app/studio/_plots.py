@@ -9,8 +9,10 @@ marked on the zero line; a caption says in plain words what the steering's curva
 like (Dubins: the bang-bang of arcs and straights).
 
 The x axis is shared arc length, so the centreline is cut to the stretch from the start to the
-goal — the part of the track the path is meant to follow. Pinned runs (_compare.py) add their
-curvature, steering and cost curves in their colours; the current run is the best path's pink.
+goal — the part of the track the path is meant to follow. The other compared runs — the pins
+(_compare.py) and, in the two-up split, run B — add their curvature, steering and cost curves
+in their colours, and their reverse stretches shaded lightly in them; the current run is the
+best path's pink (named A in the split).
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import math
 import numpy as np
 
 import tracks
-from app.studio._compare import CURRENT, cost_curves
+from app.studio._compare import CURRENT, cost_curves, hex_rgb
 from app.studio._scene import arc_length, cusp_rows, reversing
 
 __all__ = ["Profiles"]
@@ -116,6 +118,12 @@ def _shade(rev: np.ndarray, limit: float) -> np.ndarray:
     return np.where(rev, SHADE * limit, -SHADE * limit)
 
 
+def _other_shade(run, limit: float) -> dict:
+    """A compared run's reverse shading (see `_shade`): its colour, light."""
+    return _series(f"{run.name} reverse", "rgba(0,0,0,0)", 0) | {
+        "fill": "rgba({},{},{},0.13)".format(*hex_rgb(run.colour)), "fillTo": -SHADE * limit}
+
+
 def _reverse_series(limit: float) -> tuple[dict, dict]:
     """The reverse shading (a fill from +limit down to −limit under reverse stretches, see
     `_shade`) and the cusps (points on the zero line), as uPlot series."""
@@ -134,6 +142,8 @@ class Profiles:
                  max_steer_deg: float, limits: tracks.Limits) -> None:
         self._cs, self._ck = np.asarray(centre_s), np.asarray(centre_kappa)
         self._pins: list = []  # `_compare.Run`s
+        self._split = None  # run B of the two-up split, a `_compare.Run`
+        self._shown_series = None  # what the charts' series were made for
         self._path, self._current = np.zeros((0, 4)), None  # the current run, as shown
         self._goal_s = goal_s
         self._wb, self._dmax = wheelbase, max_steer_deg
@@ -175,11 +185,18 @@ class Profiles:
         """The caption for paths of this steering (`planner.STEERINGS`' names)."""
         self.caption.content = CAPTIONS[name]
 
+    @property
+    def _others(self) -> list:
+        """The compared runs besides the current one: the pins, then run B."""
+        return [*self._pins, *([self._split] if self._split is not None else [])]
+
     def _profiles(self, path: np.ndarray) -> tuple[tuple, tuple, tuple]:
         """(curvature, steering data): x, centreline, path, +max, −max, the path's reverse
-        shading and cusps, each pin on one s grid as long as the longest path (with the
-        cusps' s in it); (speed data): x, the path's speed, its envelope, 0."""
-        paths = [path, *(r.path for r in self._pins)]
+        shading and cusps, each other run's reverse shading, each other run (`_others`), on
+        one s grid as long as the longest path (with the cusps' s in it); (speed data): x,
+        the path's speed, its envelope, 0."""
+        others = self._others
+        paths = [path, *(r.path for r in others)]
         end = max((arc_length(p)[-1] for p in paths if len(p) >= 2), default=self._goal_s)
         cusps = arc_length(path)[cusp_rows(path)]
         grid = np.union1d(np.linspace(0.0, max(end, 1e-3), N), cusps)
@@ -189,12 +206,13 @@ class Profiles:
         one, rev = np.ones(len(grid)), _reverse_on(grid, path)
         marks = np.full(len(grid), math.nan)
         marks[list(self._cusps)] = 0.0
+        revs = [_reverse_on(grid, r.path) for r in others]
         kappa = (grid, centre, pk, self._kmax * one, -self._kmax * one,
-                 _shade(rev, self._kmax), marks, *pins)
+                 _shade(rev, self._kmax), marks, *(_shade(r, self._kmax) for r in revs), *pins)
         steer = (grid, _steer_deg(centre, self._wb), _steer_deg(pk, self._wb),
                  self._dmax * one, -self._dmax * one,
-                 _shade(rev, self._dmax), marks,
-                 *(_steer_deg(k, r.wheelbase) for k, r in zip(pins, self._pins)))
+                 _shade(rev, self._dmax), marks, *(_shade(r, self._dmax) for r in revs),
+                 *(_steer_deg(k, r.vehicle.wheelbase) for k, r in zip(pins, others)))
         return kappa, steer, self._speed(grid, path)
 
     def _speed(self, grid: np.ndarray, path: np.ndarray) -> tuple:
@@ -208,31 +226,56 @@ class Profiles:
                          np.sqrt(self._limits.a_lat / np.maximum(kappa, 1e-300)))
         return grid, _along(grid, s, v), _along(grid, s, cap), np.zeros(len(grid))
 
-    def show_path(self, path: np.ndarray) -> None:
-        self._path = path
-        cusps = self._cusps
+    def show_path(self, path: np.ndarray, split=None) -> None:
+        """The current run's best path and, in the split, run B (a `_compare.Run`)."""
+        self._path, self._split = path, split
         kappa, steer, speed = self._profiles(path)
-        if self._cusps != cusps:  # the points drawn are the cusps' (uPlot's points.filter)
-            self._show_series()
+        # viser's client rebuilds a chart whose series change and keeps its x zoom relative
+        # to the data: a rebuild with a new x range keeps a stale one. While the series are
+        # as many, the data goes first, so that a rebuild finds its x range in place.
+        first = len(self.curvature.series) == len(kappa)
+        if not first:
+            self._sync_series()
         self.curvature.data = _for_uplot(kappa)
         self.steering.data = _for_uplot(steer)
         self.speed.data = _for_uplot(speed)
+        if first:
+            self._sync_series()
+
+    def _sync_series(self) -> None:
+        """The charts' series anew when the runs compared or the cusps (drawn by uPlot's
+        points.filter) changed."""
+        key = (self._cusps, tuple((r.name, r.colour) for r in self._others))
+        if key != self._shown_series:
+            self._shown_series = key
+            self._show_series()
 
     def _show_series(self) -> None:
-        """Each chart's series: its own, the cusps' points where they are now, the pins'."""
-        for h, base, symbol in zip((self.curvature, self.steering, self.cost), self._series,
-                                   (" κ", " δ", "")):
+        """Each chart's series: its own (the current run named A in the split), the cusps'
+        points where they are now, the other runs' reverse shading and curves."""
+        others = self._others
+        for h, base, symbol, limit in zip((self.curvature, self.steering, self.cost),
+                                          self._series, (" κ", " δ", ""),
+                                          (self._kmax, self._dmax, None)):
+            if self._split is not None:  # the current run's series: "path κ", "best cost (m)"
+                at = 1 if h is self.cost else 2
+                base = (*base[:at], base[at] | {"label": "A" + (symbol or " best cost (m)")},
+                        *base[at + 1:])
+            shades = ()
             if h is not self.cost:
                 cusp = base[6]
                 base = (*base[:6], cusp | {"points": cusp["points"] | {"filter": self._cusps}})
-            h.series = base + tuple(_series(r.name + symbol, r.colour, 1.5) for r in self._pins)
+                shades = tuple(_other_shade(r, limit) for r in others)
+            h.series = base + shades + tuple(_series(r.name + symbol, r.colour, 1.5)
+                                             for r in others)
 
-    def show_cost(self, current) -> None:
-        """The current run's (a `_compare.Run`) best cost against planning time and the pinned
-        runs', on one time axis: each improvement's instant and the one just before it, so
-        that every curve is a staircase."""
-        self._current = current
-        curves = cost_curves([current, *self._pins])
+    def show_cost(self, current, split=None) -> None:
+        """The current run's (a `_compare.Run`) best cost against planning time and the other
+        runs' (the pins', B's in the split), on one time axis: each improvement's instant and
+        the one just before it, so that every curve is a staircase."""
+        self._current, self._split = current, split
+        self._sync_series()
+        curves = cost_curves([current, *self._others])
         t = np.unique(np.concatenate([np.r_[t, np.nextafter(t, -math.inf)] for t, _ in curves]))
         if not len(t):
             t = np.array([0.0, 1.0])
@@ -244,7 +287,6 @@ class Profiles:
         """Pinned runs (`_compare.Run`) as series of their own, named and coloured as the
         pins; the caller sends it atomically, the series with the data that matches them."""
         self._pins = list(runs)
-        self._show_series()
-        self.show_path(self._path)
+        self.show_path(self._path, self._split)
         if self._current is not None:
-            self.show_cost(self._current)
+            self.show_cost(self._current, self._split)

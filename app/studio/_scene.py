@@ -118,22 +118,23 @@ def _fill(scene, name: str, rings: list[np.ndarray], z: float, color, opacity=No
                           material="toon3", cast_shadow=False, receive_shadow=False)
 
 
-def draw_track(scene, track, kappa_max: float) -> None:
-    """Drivable surface, both edges, and the centreline coloured by curvature."""
+def draw_track(scene, track, kappa_max: float, root: str = "") -> None:
+    """Drivable surface, both edges, and the centreline coloured by curvature, under
+    ``root``/track (a frame that places a copy, as the split's second half)."""
     rings = track.region_rings()
     if track.closed and len(rings) == 2:
-        _fill(scene, "/track/surface", rings, Z["surface"], (72, 74, 82))
+        _fill(scene, f"{root}/track/surface", rings, Z["surface"], (72, 74, 82))
     else:
         for i, ring in enumerate(rings):
-            _fill(scene, f"/track/surface{i}", [ring], Z["surface"], (72, 74, 82))
+            _fill(scene, f"{root}/track/surface{i}", [ring], Z["surface"], (72, 74, 82))
     for i, ring in enumerate(rings):
-        scene.add_line_segments(f"/track/edge{i}", polyline_segments(ring, 0.0, closed=True),
+        scene.add_line_segments(f"{root}/track/edge{i}", polyline_segments(ring, 0.0, closed=True),
                                 (235, 235, 235), thickness=2.0, thickness_units="screen")
     prof = track.sample(track.detail_spacing())
     seg = polyline_segments(np.column_stack([prof.x, prof.y]), Z["centre"])
     col = curvature_colors(prof.curvature, kappa_max)
     colors = np.stack([col[:-1], col[1:]], axis=1)
-    scene.add_line_segments("/track/centre", seg, colors, thickness=3.0,
+    scene.add_line_segments(f"{root}/track/centre", seg, colors, thickness=3.0,
                             thickness_units="screen")
 
 
@@ -195,15 +196,16 @@ def offset_at(table: np.ndarray | None, t: float) -> np.ndarray:
                      np.interp(t, table[:, 0], table[:, 2])])
 
 
-def draw_obstacles(scene, scenario: planner.Scenario, track) -> list[tuple]:
-    """Static obstacles red, moving ones orange, each a frame ``/obstacles/o{i}`` at its pose
-    holding its outline; returns (frame, pose, motion table) per obstacle for `move_obstacles`."""
+def draw_obstacles(scene, scenario: planner.Scenario, track, root: str = "") -> list[tuple]:
+    """Static obstacles red, moving ones orange, each a frame ``root/obstacles/o{i}`` at its
+    pose holding its outline; returns (frame, pose, motion table) per obstacle for
+    `move_obstacles`."""
     out = []
     for i, ob in enumerate(scenario.obstacles):
         pose, local = obstacle_shape(ob)
-        frame = scene.add_frame(f"/obstacles/o{i}", show_axes=False, position=(*pose[:2], 0.0),
+        frame = scene.add_frame(f"{root}/obstacles/o{i}", show_axes=False, position=(*pose[:2], 0.0),
                                 wxyz=yaw_wxyz(pose[2]))
-        _fill(scene, f"/obstacles/o{i}/shape", [local], Z["obstacle"],
+        _fill(scene, f"{root}/obstacles/o{i}/shape", [local], Z["obstacle"],
               MOVER_RGB if ob.motion is not None else OBSTACLE_RGB)
         out.append((frame, pose, motion_table(ob.motion, track)))
     return out
@@ -275,18 +277,19 @@ def marker_size(bounds) -> float:
     return 0.006 * max(xmax - xmin, ymax - ymin)
 
 
-def draw_poses(scene, scenario: planner.Scenario, size: float) -> dict:
-    """Start (green) and goal (gold) as car footprints in frames ``/poses/start`` and
-    ``/poses/goal`` (dragging moves the frame); the goal's tolerance disc. Returns the frames."""
+def draw_poses(scene, scenario: planner.Scenario, size: float, root: str = "") -> dict:
+    """Start (green) and goal (gold) as car footprints in frames ``root/poses/start`` and
+    ``root/poses/goal`` (dragging moves the frame); the goal's tolerance disc. Returns the
+    frames."""
     frames = {}
     for name, pose, rgb in (("start", scenario.start, START_RGB),
                             ("goal", scenario.goal, GOAL_RGB)):
-        frames[name] = scene.add_frame(f"/poses/{name}", show_axes=False, position=(*pose[:2], 0.0),
+        frames[name] = scene.add_frame(f"{root}/poses/{name}", show_axes=False, position=(*pose[:2], 0.0),
                         wxyz=yaw_wxyz(pose[2]))
-        _fill(scene, f"/poses/{name}/shape", [car_outline(size, 0.5 * size)], Z["pose"], rgb)
+        _fill(scene, f"{root}/poses/{name}/shape", [car_outline(size, 0.5 * size)], Z["pose"], rgb)
     a = np.linspace(0, 2 * math.pi, 48, endpoint=False)
     ring = scenario.goal_tolerance.position * np.column_stack([np.cos(a), np.sin(a)])
-    scene.add_line_segments("/poses/goal/tol", polyline_segments(ring, Z["pose"], closed=True),
+    scene.add_line_segments(f"{root}/poses/goal/tol", polyline_segments(ring, Z["pose"], closed=True),
                             GOAL_RGB, thickness=1.5, thickness_units="screen")
     return frames
 

@@ -101,6 +101,9 @@ class Session:
         for control in (u.planner_name, u.steering, u.timing, u.eps, u.gamma, u.k_rrt,
                         u.goal_bias, u.budget, u.seed):
             control.on_update(lambda _: self._locked(run.reset))
+        for control in (u.b_planner, u.b_steering, u.b_seed):
+            control.on_update(lambda _: self._locked(run.b_changed))
+        u.split.on_update(lambda _: self._split_changed())
         u.reset.on_click(lambda _: self._locked(run.reset))
         # Commands under the lock too: a reset replaces the worker, and they must reach the new one.
         u.rate.on_update(lambda _: self._locked(run.set_rate))
@@ -131,6 +134,13 @@ class Session:
     def _locked(self, fn) -> None:
         with self._lock:
             fn()
+
+    def _split_changed(self) -> None:
+        """The two-up split on or off: the runs start over, the plots get or lose run B's
+        series (with their data, at once) and the view frames one half or both."""
+        with self.client.atomic(), self._lock:
+            self.planning.choose_split()
+            self.fit_view()
 
     def _pins_changed(self, fn) -> None:
         """Pin or clear: the plots' series and their data reach the browser together."""
@@ -190,11 +200,12 @@ class Session:
         """The scene clock moved: moving obstacles and the driving car, both at time t."""
         with self._lock:
             self.stage.show_time(t)
-            self.planning.show_car(t)
+            self.planning.show_time(t)
 
     def fit_view(self) -> None:
-        """The whole scenario in view, beside the panel as wide as it is now."""
-        self.stage.fit(self.projector.panel_px)
+        """The whole scenario in view (both halves in the split), beside the panel as wide as
+        it is now."""
+        self.stage.fit(self.projector.panel_px, self.planning.view_bounds())
 
     def _show_projector(self) -> None:
         self.projector.apply()

@@ -76,11 +76,11 @@ class Stage:
         """The scenario as planned (a custom track embedded), named ``name``."""
         return json.dumps(dict(self.scenario, name=name), indent=2)
 
-    def fit(self, panel_px: float) -> None:
-        """Look at the whole scenario beside a panel ``panel_px`` wide, once the browser has
-        reported its camera."""
+    def fit(self, panel_px: float, bounds) -> None:
+        """Look at ``bounds`` (the scenario's, or both halves of the split) beside a panel
+        ``panel_px`` wide, once the browser has reported its camera."""
         if self.problem is not None and self.client.camera.update_timestamp != 0.0:
-            fit_camera(self.client, self.problem.bounds, panel_px)
+            fit_camera(self.client, bounds, panel_px)
 
 
 def _move_frame(frame, x: float, y: float, yaw: float) -> None:
