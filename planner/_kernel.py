@@ -45,6 +45,9 @@ from planner._world import World, motion_free, static_clearance_estimate
 STEERING_METRIC, SE2_METRIC = range(2)  # planner.options.METRICS
 LANE_SHARE, LANE_SIGMA = 0.9, 0.25  # track scenarios: headings sampled along the lane
 NEAREST_BUCKETS = 256  # nearest's queue: half-cell buckets, the last one takes the rest
+# Polishes from this iteration on also shift blocks of poses: they cost twice as much, and the
+# late polishes, a doubling apart, are few (earlier ones would slow the first 0.1 s).
+BLOCKS_FROM = 8192
 # Counter indices; POLISH_AT: the iteration at which the best path is next polished;
 # POLISHED: the best cost the last polish left, in micrometres; POLISHED_AT: its iteration.
 (N, NGOAL, ITER, CHECKS, BEST, REWIRES, EVALS, IMPROVED, REFUSED, POLISH_AT, POLISHED,
@@ -497,7 +500,8 @@ def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, counter, ev) 
         node = tree.parent[node]
     code = int(P[STEERING])
     goal = np.array([P[GX], P[GY], P[GTH], P[GPOS], P[GHEAD]])
-    poses, length = polish_path(w, code, P[RHO], P[SPEED], poses, goal, kinds, lens, counter)
+    poses, length = polish_path(w, code, P[RHO], P[SPEED], poses, goal, kinds, lens, counter,
+                                tree.cnt[ITER] >= BLOCKS_FROM)
     if length >= tree.cost[tree.cnt[BEST]] - 1e-9:
         return False
     parent = root

@@ -5,7 +5,9 @@ still 2–3 % longer than the best known (benchmarks/results/planner.md). Moving
 poses closes most of that. Each pass splits every edge at its middle (more poses to move: a
 chain of steered edges can hug an obstacle), then runs coordinate descent on the poses (x, y, θ)
 with steps that halve every round — a move is taken when the steered edges it changes are
-shorter together and free by the exact motion check — then drops every pose the path can skip.
+shorter together and free by the exact motion check — then drops every pose the path can skip. Late polishes also shift blocks of 2, 4 and 8 poses
+together between two descents: a path bulging round an obstacle between poses too far apart
+for any single one to move freely moves as a whole.
 The start stays put; the end pose moves within the goal region, where the tree's first goal
 node is seldom the best place to arrive (on open_field alone that was 1 % of the length).
 Static worlds only: with moving obstacles a shorter edge changes every later arrival time,
@@ -30,6 +32,10 @@ ROUNDS = 6  # step halvings per descent: from a quarter of the mean edge to 1/10
 LOOKAHEAD = 16
 MOVES = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0],
                   [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
+BLOCKS = (2, 4, 8)  # poses shifted together, after the single-pose descent
+_D = math.sqrt(0.5)
+SHIFTS = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0], [_D, _D], [-_D, _D],
+                   [_D, -_D], [-_D, -_D]])
 
 
 @njit(cache=True, inline="always")
@@ -57,11 +63,17 @@ def _free(w: World, code: int, a, b, rho: float, speed: float, kinds, lens, coun
 
 @njit(cache=True)
 def polish_path(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
-                goal: np.ndarray, kinds, lens, counter):
-    """The path through ``poses`` ((n, 3)) shortened: (new poses, their length)."""
+                goal: np.ndarray, kinds, lens, counter, blocks: bool):
+    """The path through ``poses`` ((n, 3)) shortened: (new poses, their length); with
+    ``blocks``, each pass also shifts blocks of poses (`_shift_blocks`), which costs a polish
+    about twice as much."""
     for _ in range(PASSES):
         poses = _split(code, rho, poses, kinds, lens)
         _descend(w, code, rho, speed, poses, goal, kinds, lens, counter)
+        if blocks:
+            for width in BLOCKS:
+                _shift_blocks(w, code, rho, speed, poses, width, kinds, lens, counter)
+            _descend(w, code, rho, speed, poses, goal, kinds, lens, counter)
         poses = _prune(w, code, rho, speed, poses, kinds, lens, counter)
     total = 0.0
     for i in range(poses.shape[0] - 1):
@@ -132,6 +144,58 @@ def _descend(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
                 break
         step_xy *= 0.5
         step_th *= 0.5
+
+
+@njit(cache=True)
+def _shift_blocks(w: World, code: int, rho: float, speed: float, poses: np.ndarray, width: int,
+                  kinds, lens, counter) -> None:
+    """Coordinate descent on blocks of ``width`` inner poses shifted together, in place. A
+    path that bulges round an obstacle between poses too far apart for any one of them to move
+    freely can move as a whole; a shift keeps the steered edges inside the block."""
+    n = poses.shape[0]
+    if n - width < 2:
+        return
+    edge = np.empty(n - 1)
+    for i in range(n - 1):
+        edge[i] = _length(code, poses[i], poses[i + 1], rho, math.inf)
+    step = 0.25 * edge.mean()
+    a = np.empty(3)
+    b = np.empty(3)
+    moved = np.empty((width, 3))
+    for _ in range(ROUNDS):
+        for i in range(1, n - width):
+            j = i + width - 1
+            now = edge[i - 1] + edge[j]
+            best, pick, len_a, len_b = 1e-9, -1, 0.0, 0.0
+            for m in range(SHIFTS.shape[0]):
+                a[:] = poses[i]
+                b[:] = poses[j]
+                a[0] += SHIFTS[m, 0] * step
+                a[1] += SHIFTS[m, 1] * step
+                b[0] += SHIFTS[m, 0] * step
+                b[1] += SHIFTS[m, 1] * step
+                la = _length(code, poses[i - 1], a, rho, now)
+                lb = _length(code, b, poses[j + 1], rho, now - la)
+                if now - la - lb > best:
+                    best, pick, len_a, len_b = now - la - lb, m, la, lb
+            if pick < 0:
+                continue
+            for k in range(width):
+                moved[k, 0] = poses[i + k, 0] + SHIFTS[pick, 0] * step
+                moved[k, 1] = poses[i + k, 1] + SHIFTS[pick, 1] * step
+                moved[k, 2] = poses[i + k, 2]
+            free = (_free(w, code, poses[i - 1], moved[0], rho, speed, kinds, lens, counter)
+                    and _free(w, code, moved[width - 1], poses[j + 1], rho, speed, kinds, lens,
+                              counter))
+            k = 0
+            while free and k < width - 1:
+                free = _free(w, code, moved[k], moved[k + 1], rho, speed, kinds, lens, counter)
+                k += 1
+            if free:
+                poses[i:j + 1, :] = moved
+                edge[i - 1] = len_a
+                edge[j] = len_b
+        step *= 0.5
 
 
 @njit(cache=True)
