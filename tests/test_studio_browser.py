@@ -479,9 +479,21 @@ def test_a_scenario_saved_to_the_server_loads_back_with_its_track(browser, urls,
     click(other, "Fit view")
     wait_still(other)
     loaded = canvas_pixels(other, "13_small_track_loaded")
-    same = (np.abs(loaded - saved).sum(axis=2) < 60).mean()
-    assert same > 0.9 and (np.abs(thesis - saved).sum(axis=2) < 60).mean() < same
+    # The same track and box, framed alike: the fit leaves room for the panel, whose width a
+    # scroll bar can change between tabs, so compare shapes, not pixels (0.83 of them matched
+    # once in CI).
+    assert frame(loaded) == pytest.approx(frame(saved), abs=0.06)
+    assert frame(thesis) != pytest.approx(frame(saved), abs=0.06)
     other.close()
+
+
+def frame(img: np.ndarray) -> tuple[float, ...]:
+    """The track's drawn shape (width over height) and where the red box lies in it
+    (fractions of the track's width and height)."""
+    ys, xs = np.nonzero((img.sum(axis=2) < 300) | red(img))
+    x0, y0, w, h = xs.min(), ys.min(), np.ptp(xs), np.ptp(ys)
+    cx, cy = centroid(red(img))
+    return w / h, (cx - x0) / w, (cy - y0) / h
 
 
 def test_the_studies_folder_lists_the_servers_studies_opens_and_downloads_a_report(browser,
