@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import json
 import re
+import signal
 import sqlite3
 import subprocess
 import sys
@@ -134,9 +135,12 @@ def test_ctrl_c_keeps_finished_runs_and_the_next_invocation_goes_on(study_file, 
     study_file.write_text(STUDY.replace("iterations: 400", "iterations: 4000").replace(
         "seeds: 2", "seeds: 8"))
     out = tmp_path / "out"
+    # Ctrl-C as a terminal delivers it: a process that ignores SIGINT hands the ignoring on
+    # to its children, so the study gets the default disposition back whatever this one has.
     proc = subprocess.Popen(["trackstar", "study", str(study_file), "--out", str(out),
                              "--workers", "1"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     ctrl_c = subprocess.Popen([sys.executable, "-c", CTRL_C_LATER, str(out / "results.sqlite"),
                                str(proc.pid)])
     out_text, err = proc.communicate(timeout=120)
