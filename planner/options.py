@@ -34,7 +34,7 @@ Seed = Annotated[int, Field(ge=0, lt=2**64)]
 class PlanOptions(BaseModel):
     """Every option of a planning run, with its default; the budget (time, iterations) too."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, defer_build=True)
 
     planner: Literal[PLANNERS] = Field(
         "rrtstar", description="Planning algorithm: RRT stops at its first solution, RRT* "

@@ -35,7 +35,7 @@ def suggest(key: Any, valid: Iterable[str]) -> str:
 class StrictModel(BaseModel):
     """A frozen model of finite numbers that names an unknown key and suggests the nearest."""
 
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True, defer_build=True)
 
     @model_validator(mode="before")
     @classmethod

@@ -1,5 +1,6 @@
-"""Start-up: commands that do not plan load no numba and no compiled kernel, and a plan without
-a track loads no track package (issue 22)."""
+"""Start-up: commands that do not plan load no numba and no compiled kernel, a plan loads none of
+numba's implementation modules (a cached kernel needs none), and a plan without a track loads no
+track package (issue 22)."""
 
 import subprocess
 import sys
@@ -11,8 +12,9 @@ THESIS = Path(__file__).resolve().parents[1] / "tracks" / "library" / "thesis.sv
 # The CLI's entry point run as the `trackstar` script runs it; then which heavy modules loaded.
 CLI = ("import sys\nfrom app.cli import main\nsys.argv = ['trackstar', *sys.argv[1:]]\n"
        "try:\n    main()\nexcept SystemExit:\n    pass\n"
-       "print(sorted(m for m in ('numba', 'planner._kernel', 'planner._world', 'tracks') "
-       "if m in sys.modules), file=sys.stderr)")
+       "print(sorted(m for m in ('numba', 'planner._kernel', 'planner._world', 'tracks', "
+       "'numba.np.arrayobj', 'numba.np.arraymath', 'scipy.linalg') if m in sys.modules), "
+       "file=sys.stderr)")
 
 
 def loaded(*args: str) -> str:
@@ -34,3 +36,25 @@ def test_a_plan_loads_the_kernels_and_tracks_only_for_a_track():
     kernels = "'numba', 'planner._kernel', 'planner._world'"
     assert loaded("plan", "slalom", "--iterations", "1") == f"[{kernels}]"
     assert loaded("plan", "thesis_static", "--iterations", "1") == f"[{kernels}, 'tracks']"
+
+
+LINKED = """
+import llvmlite.binding as ll
+from planner import _kernel, rrt
+rrt.warm_up()
+library = next(iter(_kernel.iterate.overloads.values())).library
+assert library._shared_module is None  # loaded without parsing its bitcode
+elf = library._codegen._engine._defined_symbols
+module = library._get_module_for_linking()  # a compile that links it parses it now
+shared = {g.name for g in [*module.functions, *module.global_variables]
+          if not g.is_declaration and g.linkage != ll.Linkage.private}
+print(len(shared), sorted(shared - elf))
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="the object code is ELF on Linux only")
+def test_a_cached_kernel_defines_its_bitcodes_symbols_without_parsing_it():
+    out = subprocess.run([sys.executable, "-c", LINKED], capture_output=True, text=True,
+                         timeout=60, check=True)
+    count, missing = out.stdout.split(" ", 1)
+    assert int(count) > 100 and missing.strip() == "[]"
