@@ -37,8 +37,8 @@ def _array_math_without_blas() -> None:
         del sys.modules[_BLAS]
 
 
-def _cache_loads_without_registries() -> None:
-    from numba.core import caching
+def _cache_loads_without_registries() -> bool:
+    from numba.core import caching, entrypoints
     from numba.core.runtime import rtsys
 
     def load_overload(self, sig, target_context):
@@ -46,13 +46,15 @@ def _cache_loads_without_registries() -> None:
         with self._guard_against_spurious_io_errors():
             loaded = self._load_overload(sig, target_context)
         if loaded is None:  # not cached: a compile follows, and loads the registries
+            entrypoints.init_all()
             _array_math_without_blas()
         return loaded
 
     if hasattr(caching.Cache, "_load_overload"):
         caching.Cache.load_overload = load_overload
-    else:  # a numba we do not know: leave its loads be, and keep SciPy out of its registries
-        _array_math_without_blas()
+        return True
+    _array_math_without_blas()  # a numba we do not know: leave its loads be, keep SciPy out
+    return False
 
 
 def _environments_without_imports() -> None:
@@ -101,7 +103,8 @@ def _object_code_without_bitcode() -> None:
     from numba.core import codegen
 
     library = codegen.CPUCodeLibrary
-    if not hasattr(library, "_get_module_for_linking"):
+    if not (hasattr(library, "_get_module_for_linking")
+            and hasattr(codegen.JitEngine, "_load_defined_symbols")):
         return  # a numba we do not know: leave it be
     unserialize, for_linking = library._unserialize.__func__, library._get_module_for_linking
 
@@ -128,10 +131,30 @@ def _object_code_without_bitcode() -> None:
     library._get_module_for_linking = _get_module_for_linking
 
 
-_cache_loads_without_registries()
+_LOADS_OWN_EXTENSIONS = _cache_loads_without_registries()
 _environments_without_imports()
 _object_code_without_bitcode()
 
-from numba import float64, njit, typeof, uint64  # noqa: E402
+import numba  # noqa: E402
+from numba import float64, typeof, uint64  # noqa: E402
 
 __all__ = ["float64", "njit", "typeof", "uint64"]
+
+
+def njit(**options):
+    """numba's njit for a kernel. With ``cache=True`` its first call looks for numba's
+    extensions (an entry-point scan of every installed package) only when it compiles; a cache
+    load needs none."""
+
+    def decorate(function):
+        kernel = numba.njit(**options)(function)
+        if options.get("cache") and _LOADS_OWN_EXTENSIONS:
+            kernel._compilation_chain_init_hook = _no_extensions_before_the_cache
+        return kernel
+
+    return decorate
+
+
+def _no_extensions_before_the_cache() -> None:
+    """A kernel's hook before it compiles or loads: nothing, for a cache miss scans numba's
+    extensions (`load_overload`)."""
