@@ -27,6 +27,8 @@ MAX_DURATION_S = 600.0  # simulated seconds per run: a worker is busy for up to 
 MIN_RATE_HZ, MAX_RATE_HZ = 0.1, 1_000.0  # replanning, control, sensing: 1e12 Hz ran for ever
 MAX_NOISE_M = 100.0  # σ of sensed positions: a sensor that far off senses nothing
 MAX_LATENCY_MS = 60_000.0  # a fixed cycle time of a minute
+# The prediction's uncertainty: beyond these every mover covers the whole scene anyway.
+MAX_PREDICT_ACCEL, MAX_PREDICT_SPEED, MAX_PREDICT_HORIZON_S = 100.0, 100.0, 60.0
 
 Rate = Annotated[float, Field(ge=MIN_RATE_HZ, le=MAX_RATE_HZ, allow_inf_nan=False)]
 PROGRESS_EVERY_S = 0.25  # wall time between progress writes
@@ -54,6 +56,21 @@ class SimOptions(BaseModel):
     timing: Literal[TIMINGS] = Field(
         "constant", description="optimal: the car may stop for a mover on its path instead of "
                                 "going round it")
+
+    predict_accel: Annotated[float, Field(ge=0, le=MAX_PREDICT_ACCEL,
+                                          allow_inf_nan=False)] | None = Field(
+        None, description="m/s²: the most a mover may change its velocity per second; "
+                          "predictions grow by ½·a·τ² with the look-ahead τ (default: the "
+                          "scenario's prediction.accel, else 1.0)")
+    predict_speed_error: Annotated[float, Field(ge=0, le=MAX_PREDICT_SPEED,
+                                                allow_inf_nan=False)] | None = Field(
+        None, description="m/s: the most a sensed velocity may be off; predictions grow by it "
+                          "times τ (default: the scenario's prediction.speed_error, else 0.1)")
+    predict_horizon: Annotated[float, Field(ge=0, le=MAX_PREDICT_HORIZON_S,
+                                            allow_inf_nan=False)] | None = Field(
+        None, description="s of look-ahead over which the predictions grow; held beyond "
+                          "(default: the scenario's prediction.horizon, else 1.5)")
+    reverse: bool = Field(True, description="the car may back up to evade a mover")
 
     def settings(self, **local):
         """The `planner.sim.SimSettings` of these options and of ``local`` ones (the command

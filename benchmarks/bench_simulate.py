@@ -4,9 +4,11 @@
     python benchmarks/bench_simulate.py --seeds 5 --jobs 1 --scenes thesis_laps
 
 Scenes (bundled scenarios): the reference crossing, three in which a mover stops in the
-lane, turns into it, or backs up into it — so that a plan made once at t = 0 collides — and two
+lane, turns into it, or backs up into it — so that a plan made once at t = 0 collides — two
 laps of the thesis track among static boxes and track-following movers (lap mode; there
-"replanning off" keeps extending the path to the rolling goal, but on the t = 0 sensing alone).
+"replanning off" keeps extending the path to the rolling goal, but on the t = 0 sensing alone),
+and an open square with ten walkers (issue 30's goal: cycle p99 ≤ 33 ms at 30 Hz, the median
+over seeds of each run's p99).
 Cycle times are measured wall-clock times on this machine (noisy when it is shared); "wall /
 sim" is a run's wall time (scenario compilation included) over the time it simulated. Shows a
 progress bar and rewrites benchmarks/results/simulate.md after each scene.
@@ -15,6 +17,7 @@ progress bar and rewrites benchmarks/results/simulate.md after each scene.
 from __future__ import annotations
 
 import argparse
+import math
 import statistics
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -23,7 +26,7 @@ import _harness
 import numpy as np
 from tqdm import tqdm
 
-SCENES = ["crossing", "stop_in_lane", "turn_into_lane", "back_up", "thesis_laps"]
+SCENES = ["crossing", "stop_in_lane", "turn_into_lane", "back_up", "thesis_laps", "crowd_square"]
 LAPS = {"thesis_laps": 2}  # lap mode: laps to drive; other scenes drive to their goal
 
 
@@ -47,20 +50,23 @@ def one(job: tuple[str, int, bool, float]) -> dict:
 
 def table(rows: list[dict]) -> str:
     out = [("| scene | replanning | reached (laps done) | runs with collisions | collisions | min clearance "
-            "(m) | emergency stops | cycle p50 / p99 / max (ms) | share ≤ 33 ms / ≤ 250 ms | "
-            "wall / sim median / max |"),
-           "|---|---|---|---|---|---|---|---|---|---|"]
+            "(m) | of them moving | emergency stops | cycle p50 / p99 / max (ms) | median of "
+            "runs' p99 (ms) | share ≤ 33 ms / ≤ 250 ms | wall / sim median / max |"),
+           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for (scene, replan), group in _groups(rows):
         ms = np.concatenate([np.asarray(r["cycle_s"]) * 1000.0 for r in group])
         reached = sum(r["reached_goal"] for r in group)
         hit = sum(r["collisions"] > 0 for r in group)
+        p99 = statistics.median(np.percentile(r["cycle_s"], 99) * 1000.0 for r in group
+                                if r["cycle_s"]) if replan else math.nan
         timing = (f"{np.percentile(ms, 50):.1f} / {np.percentile(ms, 99):.1f} / {ms.max():.1f} | "
-                  f"{np.mean(ms <= 1000 / 30):.3f} / {np.mean(ms <= 250):.3f}") if replan \
-            else ("t = 0 sensing | —" if scene in LAPS else "one plan | —")
+                  f"{p99:.1f} | {np.mean(ms <= 1000 / 30):.3f} / {np.mean(ms <= 250):.3f}") \
+            if replan else ("t = 0 sensing | — | —" if scene in LAPS else "one plan | — | —")
         ratios = [r["wall_ratio"] for r in group]
         out.append(f"| {scene} | {'on' if replan else 'off'} | {reached}/{len(group)} | "
                    f"{hit}/{len(group)} | {sum(r['collisions'] for r in group)} | "
                    f"{min(r['min_clearance_m'] for r in group):.3f} | "
+                   f"{sum(r['collisions_moving'] for r in group)} | "
                    f"{sum(r['emergency_stops'] for r in group)} | {timing} | "
                    f"{statistics.median(ratios):.2f} / {max(ratios):.2f} |")
     return "\n".join(out)

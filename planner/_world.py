@@ -48,6 +48,7 @@ class World(NamedTuple):
     m_vel: np.ndarray  # (nm, 2)
     m_wp_start: np.ndarray  # (nm + 1,)
     m_wp: np.ndarray  # (nw, 3) t, dx, dy
+    m_grow: np.ndarray  # (nm, 5) a prediction's uncertainty: see `growth`; zeros for true motions
     sdf: np.ndarray  # (nx, ny) static clearance at cell centres (a lower-bound lookup table)
     sdf_geo: np.ndarray  # float64[3]: x0, y0, cell size
     lane: np.ndarray  # (nx, ny) driving direction of the nearest centreline point, NaN
@@ -107,7 +108,8 @@ def build_world(bounds, radius, circles, polygons, motions, rings=(), centreline
             math.sqrt((xmax - xmin) * (ymax - ymin) * per_cell / GRID_WORK))
     nx, ny = math.ceil((xmax - xmin) / h), math.ceil((ymax - ymin) / h)
     world = World(geo, discs, circ, circ_motion, poly_edges, poly_start, poly_bbox, poly_motion,
-                  ring_edges, m_kind, m_vel, m_wp_start, m_wp, np.zeros((nx, ny)),
+                  ring_edges, m_kind, m_vel, m_wp_start, m_wp, np.zeros((len(motions), 5)),
+                  np.zeros((nx, ny)),
                   np.array([xmin, ymin, h]),
                   np.full((nx, ny) if centreline is not None else (0, 0), np.nan))
     _fill_sdf(world)
@@ -149,7 +151,7 @@ def without_movers(world: World) -> World:
         poly_start=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
         poly_bbox=world.poly_bbox[keep_p], poly_motion=world.poly_motion[keep_p],
         m_kind=np.zeros(0, np.int64), m_vel=np.zeros((0, 2)), m_wp_start=np.zeros(1, np.int64),
-        m_wp=np.zeros((0, 3)))
+        m_wp=np.zeros((0, 3)), m_grow=np.zeros((0, 5)))
 
 
 @njit(cache=True)
@@ -172,6 +174,17 @@ def offset(w: World, m: int, t: float):
     f = (t - w.m_wp[a, 0]) / (w.m_wp[b, 0] - w.m_wp[a, 0])
     return (w.m_wp[a, 1] + f * (w.m_wp[b, 1] - w.m_wp[a, 1]),
             w.m_wp[a, 2] + f * (w.m_wp[b, 2] - w.m_wp[a, 2]))
+
+
+@njit(cache=True, inline="always")
+def growth(w: World, m: int, t: float) -> float:
+    """How far motion ``m`` may be from where it is predicted at time t: a predicted mover is
+    its shape grown by e + e_v·τ + ½·a·τ², τ its look-ahead time from the sensing (age + t)
+    held at the horizon T (``m_grow[m]`` = e, e_v, a, age, T; all zero for a true motion).
+    ``geo[VMAX_OBS]`` must include its fastest growth, e_v + a·T."""
+    g = w.m_grow[m]
+    tau = min(max(t + g[3], 0.0), g[4])
+    return g[0] + tau * (g[1] + 0.5 * g[2] * tau)
 
 
 @njit(cache=True, inline="always")
@@ -214,31 +227,33 @@ def _point_obstacles(w: World, x: float, y: float, t: float, moving: bool, c: fl
         m = w.circ_motion[i]
         if (m >= 0) != moving:
             continue
-        cx, cy = w.circ[i, 0], w.circ[i, 1]
+        cx, cy, r = w.circ[i, 0], w.circ[i, 1], w.circ[i, 2]
         if moving:
             ox, oy = offset(w, m, t)
             cx += ox
             cy += oy
-        if max(abs(x - cx), abs(y - cy)) - w.circ[i, 2] >= c:
+            r += growth(w, m, t)
+        if max(abs(x - cx), abs(y - cy)) - r >= c:
             continue  # this circle cannot be nearer than what we have
-        d = math.hypot(x - cx, y - cy) - w.circ[i, 2]
+        d = math.hypot(x - cx, y - cy) - r
         if d < c:
             c = d
     for p in range(w.poly_bbox.shape[0]):
         m = w.poly_motion[p]
         if (m >= 0) != moving:
             continue
-        px, py = x, y
+        px, py, grown = x, y, 0.0
         if moving:
             ox, oy = offset(w, m, t)
             px -= ox
             py -= oy
+            grown = growth(w, m, t)
         bx = max(w.poly_bbox[p, 0] - px, 0.0, px - w.poly_bbox[p, 2])
         by = max(w.poly_bbox[p, 1] - py, 0.0, py - w.poly_bbox[p, 3])
-        if math.hypot(bx, by) >= c:
+        if math.hypot(bx, by) - grown >= c:
             continue  # this polygon cannot be nearer than what we have
         d, inside = _edges_distance(w.poly_edges, w.poly_start[p], w.poly_start[p + 1], px, py)
-        d = -d if inside else d
+        d = (-d if inside else d) - grown
         if d < c:
             c = d
     return c
@@ -416,6 +431,15 @@ def motion_free(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> boo
         x, y, th = advance(x, y, th, kinds[i], seg, rho)
         driven += length
     return True
+
+
+@njit(cache=True)
+def path_moving_clearances(w: World, samples: np.ndarray) -> np.ndarray:
+    """`moving_clearance` at each row (x, y, theta, …, t in column 5) of ``samples``."""
+    out = np.empty(samples.shape[0])
+    for k in range(samples.shape[0]):
+        out[k] = moving_clearance(w, samples[k, 0], samples[k, 1], samples[k, 2], samples[k, 5])
+    return out
 
 
 @njit(cache=True)

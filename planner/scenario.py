@@ -259,6 +259,18 @@ class TrackRef(StrictModel):
         return self.svg if self.svg is not None else self.csv
 
 
+class Prediction(StrictModel):
+    """How erratic the scene's movers are, for a simulated car that predicts them
+    (docs/simulation.md, `planner.sim.predict.Uncertainty`); unset fields take its defaults."""
+
+    accel: Annotated[float, Field(ge=0, le=MAX_ACCEL_M_S2)] | None = Field(
+        None, description="m/s²: the most a mover changes its velocity per second")
+    speed_error: Annotated[float, Field(ge=0, le=MAX_SPEED_M_S)] | None = Field(
+        None, description="m/s: the most a sensed velocity is off")
+    horizon: Annotated[float, Field(ge=0, le=MAX_HORIZON_S)] | None = Field(
+        None, description="s of look-ahead over which the predictions widen; held beyond")
+
+
 class Scenario(StrictModel):
     """A planning problem. Units: metres and radians, except the ``*_deg`` fields."""
 
@@ -271,6 +283,7 @@ class Scenario(StrictModel):
     goal: Pose
     goal_tolerance: GoalTolerance = GoalTolerance()
     obstacles: list[Obstacle] = Field([], max_length=MAX_OBSTACLES)
+    prediction: Prediction = Prediction()
 
     @model_validator(mode="after")
     def _region(self) -> Scenario:

@@ -173,7 +173,7 @@ def test_log_replays_and_respects_the_limits(crossing_run):
 def test_replanning_passes_movers_a_blind_plan_hits(scene):
     """A mover stops (or backs up) in the lane: the replanning car passes it, the car that
     follows its t = 0 plan collides — recounted independently from the log."""
-    scn, run = _run(scene, duration=22.0, seed=2)
+    scn, run = _run(scene, duration=30.0, seed=2)
     assert run.summary["reached_goal"] and run.summary["collisions"] == 0
     assert _independent_collisions(scn, run.log) == 0
     _, blind = _run(scene, duration=22.0, seed=2, replan=False)

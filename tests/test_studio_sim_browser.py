@@ -81,11 +81,14 @@ def test_simulate_plays_the_crossing_live(browser, ui_url):
     # question; measured cycle times on a loaded machine change the run).
     assert "done" in wait_status(page, "done", 120), sim_status(page)
     # The plots: two more uPlot charts, with their curves drawn.
-    assert page.locator(".uplot canvas").count() >= 5
+    assert page.locator(".uplot canvas").count() >= 6
     steering = page.locator(".uplot", has_text="Soll")
     assert colour_pixels(chart(page, steering, "sim_steering"), (74, 144, 226)) > 30, "no Ist"
     lateral = page.locator(".uplot", has_text="lateral error")
     assert colour_pixels(chart(page, lateral, "sim_lateral"), (142, 68, 173)) > 30, "no error"
+    safety = page.locator(".uplot", has_text="Safety timeline")  # issue 30: speed, guard, contacts
+    assert colour_pixels(chart(page, safety, "sim_safety"), (46, 139, 87)) > 30, "no speed"
+    assert "guard" in page.locator("td", has_text="guard").first.inner_text()
     assert sb.metric(page, "cycles") > 100
     page.screenshot(path=str(sb.ARTIFACTS / "sim_done_panel.png"))
     page.close()

@@ -79,7 +79,7 @@ def test_a_study_runs_its_grid_and_stores_the_numbers_plan_prints(study_file, tm
         assert len(list(reader)) == 16
     check_report(default_out, ["open_field", "slalom"])
     with sqlite3.connect(default_out / "results.sqlite") as db:
-        assert db.execute("PRAGMA user_version").fetchone() == (1,)
+        assert db.execute("PRAGMA user_version").fetchone() == (2,)
         for run_id, cost in db.execute("SELECT id, cost FROM runs WHERE solved"):
             curve = [c for (c,) in db.execute("SELECT cost FROM cost_over_time WHERE run_id = ? "
                                               "ORDER BY iteration", (run_id,))]
@@ -242,8 +242,9 @@ def test_a_driven_study_stores_what_simulate_prints(tmp_path):
     out = trackstar("study", str(study), "--out", str(tmp_path / "out"), "--json")
     assert out.returncode == 0, out.stderr
     assert json.loads(out.stdout)["done"] == 2
-    columns = ("parameters", "reached", "collisions", "min_clearance_m", "time_to_goal_s",
-               "cycle_p99_ms", "replans", "emergency_stops", "max_lateral_error_m")
+    columns = ("parameters", "reached", "collisions", "collisions_moving", "collisions_at_rest",
+               "min_clearance_m", "time_to_goal_s", "cycle_p99_ms", "replans",
+               "emergency_stops", "max_lateral_error_m")
     with sqlite3.connect(tmp_path / "out" / "results.sqlite") as db:
         stored = db.execute(f"SELECT {', '.join(columns)} FROM sim_runs").fetchall()
     assert len(stored) == 2
@@ -251,12 +252,14 @@ def test_a_driven_study_stores_what_simulate_prints(tmp_path):
         rate = json.loads(params)["rate"]
         s = json.loads(trackstar("simulate", "crossing", "--rate", str(rate), "--fixed-latency",
                                  "20", "--duration", "12", "--seed", "1", "--json").stdout)
-        assert numbers == [int(s["reached_goal"]), s["collisions"], s["min_clearance_m"],
+        assert numbers == [int(s["reached_goal"]), s["collisions"], s["collisions_moving"],
+                           s["collisions_at_rest"], s["min_clearance_m"],
                            s["time_to_goal_s"], s["cycle_ms"]["p99"], s["replans"],
                            s["emergency_stops"], s["cross_track_error_m"]["max"]]
     page = (tmp_path / "out" / "report.html").read_text()
     assert "goal reached" in page and "Against rate" in page
     assert (tmp_path / "out" / "figures" / "crossing_collisions.png").is_file()
+    assert (tmp_path / "out" / "figures" / "crossing_collisions_moving.png").is_file()
 
 
 @pytest.mark.parametrize("edit, words", [
@@ -359,3 +362,28 @@ def test_without_ompl_its_planners_say_how_to_install_it(tmp_path):
     assert out.returncode == 2 and not (tmp_path / "o").exists()
     assert out.stderr.strip().splitlines() == [
         f"error: {study}: planners: ompl:rrtstar needs OMPL: pip install 'trackstar[bench]'"]
+
+
+def test_a_results_file_of_schema_1_gains_the_collision_split(tmp_path):
+    """A study stored before issue 30 (sim_runs without the split) is resumed, not broken."""
+    from app.study.results import Results
+
+    with sqlite3.connect(tmp_path / "results.sqlite") as db:
+        db.executescript("""
+            CREATE TABLE sim_runs (id INTEGER PRIMARY KEY, study TEXT NOT NULL,
+                scenario TEXT NOT NULL, parameters TEXT NOT NULL, seed INTEGER NOT NULL,
+                reached INTEGER, collisions INTEGER, min_clearance_m REAL,
+                time_to_goal_s REAL, cycle_p50_ms REAL, cycle_p99_ms REAL, replans INTEGER,
+                emergency_stops INTEGER, max_lateral_error_m REAL, wall_s REAL, error TEXT,
+                trackstar_version TEXT NOT NULL, finished_at TEXT NOT NULL,
+                UNIQUE (study, scenario, parameters, seed));
+            INSERT INTO sim_runs (study, scenario, parameters, seed, reached, collisions,
+                trackstar_version, finished_at) VALUES ('old', 'crossing', '{}', 0, 1, 0, '0',
+                'then');
+            PRAGMA user_version = 1;""")
+    Results(tmp_path, "old", "simulate", "name: old").close()
+    with sqlite3.connect(tmp_path / "results.sqlite") as db:
+        columns = [r[1] for r in db.execute("PRAGMA table_info(sim_runs)")]
+        assert {"collisions_moving", "collisions_at_rest"} <= set(columns)
+        assert db.execute("SELECT reached, collisions_moving FROM sim_runs").fetchall() == [(1, None)]
+        assert db.execute("PRAGMA user_version").fetchone() == (2,)

@@ -37,6 +37,18 @@ def simulate(
     timing: Annotated[str, typer.Option(
         help="constant or optimal: the car may stop for a mover on its path instead of going "
              "round it (when it can go on within 10 s).")] = "constant",
+    predict_accel: Annotated[float | None, typer.Option(
+        help="m/s²: the most a mover may change its velocity per second; predictions grow by "
+             "½·a·τ² with the look-ahead τ. Default: the scenario's prediction.accel, else "
+             "1.0.")] = None,
+    predict_speed_error: Annotated[float | None, typer.Option(
+        help="m/s: the most a sensed velocity may be off; predictions grow by it times τ. "
+             "Default: the scenario's prediction.speed_error, else 0.1.")] = None,
+    predict_horizon: Annotated[float | None, typer.Option(
+        help="s of look-ahead over which the predictions grow; held beyond. Default: the "
+             "scenario's prediction.horizon, else 1.5.")] = None,
+    reverse: Annotated[bool, typer.Option(
+        help="The car may back up to evade a mover.")] = True,
     realtime: Annotated[bool, typer.Option(help="Pace the run to the wall clock.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     log: Annotated[Path | None, typer.Option(help="Write the per-tick log (CSV).")] = None,
@@ -59,7 +71,10 @@ def simulate(
         settings = SimOptions(duration=duration, rate=rate, control_rate=control_rate,
                               sense_rate=sense_rate, controller=controller, noise=noise,
                               seed=seed, fixed_latency_ms=fixed_latency, replan=not no_replan,
-                              laps=laps, timing=timing).settings(realtime=realtime)
+                              laps=laps, timing=timing, predict_accel=predict_accel,
+                              predict_speed_error=predict_speed_error,
+                              predict_horizon=predict_horizon,
+                              reverse=reverse).settings(realtime=realtime)
         problem = core.compile_problem(core.load_scenario(scenario))
         for name, out in (("--log", log), ("--raceline", raceline)):
             if out is not None and not out.parent.is_dir():
@@ -93,8 +108,10 @@ def _print_summary(name: str, s: dict) -> None:
         b = s["behaviour"]
         typer.echo(f"  behaviour: {len(b['transitions'])} transitions, "
                    f"final state '{b['final_state']}'")
-    typer.echo(f"  collisions {s['collisions']}, min clearance {s['min_clearance_m']:.3f} m, "
-               f"emergency stops {s['emergency_stops']}, planned waits {s['planned_waits']}")
+    typer.echo(f"  collisions {s['collisions']} ({s['collisions_moving']} moving, "
+               f"{s['collisions_at_rest']} at rest), min clearance {s['min_clearance_m']:.3f} m")
+    typer.echo(f"  emergency stops {s['emergency_stops']}, planned waits {s['planned_waits']}, "
+               f"brakes {s['brakes']}, evasions {s['evasions']}")
     c = s["cycle_ms"]
     if c["p50"] is not None:
         typer.echo(f"  {s['cycles']} cycles, {s['replans']} replans; cycle ms p50 {c['p50']:.1f}"

@@ -6,8 +6,11 @@ since a planner's arrays are only safe to read on the thread that runs it. The s
 calls `SimView.tick`, which draws the latest state: the car; the movers where they truly are
 (the stage's own obstacles, the scene clock set to the simulation's time); where the car
 believes they are (translucent ghosts: the last sensing extrapolated at constant velocity, with
-a line to where it predicts them ``PREDICT_S`` later); the committed path, the tree, Soll/Ist
-steering and lateral error plots and the metrics.
+a line to where it predicts them ``PREDICT_S`` later) and their grown predictions (issue 30:
+the shape grown by the run's uncertainty at look-aheads ``LOOK_AHEAD_S``, fading with τ); the
+committed path, the tree, Soll/Ist steering and lateral error plots, a safety timeline (speed,
+what the guard has the car do, contacts) and the metrics. The scene marks where the car braked,
+waited, evaded or backed off, and each collision with whose it was.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+import shapely
 from pydantic import ValidationError
 
 import planner
@@ -35,7 +39,7 @@ from app.studio._scene import (
 )
 from planner.sim import SimSettings
 from planner.sim.control import CONTROLLERS
-from planner.sim.run import Frame, simulate
+from planner.sim.run import GUARD_CODES, Frame, simulate
 from planner.sim.sensing import mover_index
 from planner.validation import describe
 
@@ -52,7 +56,10 @@ GHOST_RGB = (90, 200, 255)
 GHOST_Z = Z["obstacle"] + 0.001
 STALL_S = 2.0  # s standing still (not at the goal) that the scene marks as a stall
 STILL_V = 1e-3  # m/s below which the car stands
-EVENT_RGB = {"collision": (230, 30, 30), "stall": (240, 170, 0)}
+EVENT_RGB = {"collision": (230, 30, 30), "stall": (240, 170, 0), "brake": (255, 120, 0),
+             "wait": (60, 160, 255), "evade": (200, 40, 200), "back-off": (120, 90, 200)}
+LOOK_AHEAD_S = (0.5, 1.0, 1.5)  # s: grown predictions drawn, fading with the look-ahead
+GROWN_OPACITY = (0.22, 0.14, 0.08)
 
 
 @dataclass
@@ -69,6 +76,7 @@ class SimControls:
     metrics: object
     steering: object
     lateral: object
+    safety: object
 
 
 def build_controls(gui) -> SimControls:
@@ -93,8 +101,16 @@ def build_controls(gui) -> SimControls:
             (t, nan), ({"label": "t (s)"},
                        {"label": "lateral error (cm)", "stroke": "#8e44ad", "width": 1.5}),
             title="Lateral error to the path being followed", **common)
+        codes = " ".join(f"{v} {k}" for k, v in GUARD_CODES.items())
+        safety = gui.add_uplot(
+            (t, nan, nan, nan),
+            ({"label": "t (s)"},
+             {"label": "speed (m/s)", "stroke": "#2e8b57", "width": 1.5},
+             {"label": f"guard ({codes})", "stroke": "#ff7800", "width": 1.5},
+             {"label": "contact (1 moving, 2 at rest)", "stroke": "#e61e1e", "width": 2.0}),
+            title="Safety timeline: speed, what the guard did, contacts", **common)
     return SimControls(rate, controller, noise, seed, simulate_, stop, status, metrics,
-                       steering, lateral)
+                       steering, lateral, safety)
 
 
 class _Stopped(Exception):
@@ -107,7 +123,8 @@ class _Run:
     def __init__(self, problem, settings: SimSettings) -> None:
         self.problem = problem
         self.frame: Frame | None = None
-        self.history: list[tuple[float, float, float, float]] = []  # t, δ set, δ, e
+        # t, δ set, δ, e, v, guard code, contact (0, 1 moving, 2 at rest)
+        self.history: list[tuple[float, ...]] = []
         self.cycle_ms: list[float] = []
         self.clearance, self.min_clearance = math.nan, math.inf
         self.tree = np.zeros((0, 2, 3), np.float32)
@@ -117,6 +134,8 @@ class _Run:
         # (t, x, y, kind, cause) of each collision and stall: marked in the scene.
         self.events: list[tuple[float, float, float, str, str]] = []
         self._colliding, self._still_since, self._stall_marked = False, None, False
+        self._contact = 0
+        self._guard, self._v = "follow", 0.0  # the last frame's guard state and speed
         self._tree_of, self._tree_at = None, -math.inf
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._main, args=(settings,), daemon=True,
@@ -142,13 +161,16 @@ class _Run:
     def _observe(self, f: Frame) -> None:
         if self._stop.is_set():
             raise _Stopped
-        self.history.append((f.t, f.steer_set, f.steer, f.lateral_error))
         if f.cycles > len(self.cycle_ms):
             self.cycle_ms.append(f.cycle_ms)
         x, y, theta = f.pose
         self.clearance = self.problem.clearance(x, y, f.t, theta)
         self.min_clearance = min(self.min_clearance, self.clearance)
         self._note_events(f)
+        contact = 0 if self.clearance > 0.0 else self._contact
+        self.history.append((f.t, f.steer_set, f.steer, f.lateral_error, f.v,
+                             GUARD_CODES[f.guard], contact))
+        self._v = f.v
         now = time.monotonic()
         fresh = f.tree is not None and f.tree is not self._tree_of
         if fresh and now - self._tree_at > TREE_S:
@@ -163,8 +185,15 @@ class _Run:
         (marked where it began), with its cause: no path yet, or a predicted conflict ahead."""
         x, y, _ = f.pose
         if self.clearance <= 0.0 and not self._colliding:
-            self.events.append((f.t, x, y, "collision", f"clearance {self.clearance:.2f} m"))
+            # Whose: the car's when it moved into it (the speed held over the tick before).
+            moving = abs(self._v) > 1e-9
+            self._contact = 1 if moving else 2
+            self.events.append((f.t, x, y, "collision", f"clearance {self.clearance:.2f} m, "
+                                f"{'car moving' if moving else 'car at rest'}"))
         self._colliding = self.clearance <= 0.0
+        if f.guard != self._guard and f.guard in EVENT_RGB:
+            self.events.append((f.t, x, y, f.guard, f"at {f.v:.2f} m/s"))
+        self._guard = f.guard
         if abs(f.v) > STILL_V:
             self._still_since, self._stall_marked = None, False
         elif self._still_since is None:
@@ -216,6 +245,7 @@ class SimView:
     def start(self, problem, settings: SimSettings) -> None:
         """A new run of ``problem`` (the caller keeps the planner's own run out of its way)."""
         self.clear()
+        self._uncertainty = settings.uncertainty(problem.scenario)
         self._draw_static(problem)
         self.clock.reach(settings.duration)
         self.run = _Run(problem, settings)
@@ -251,6 +281,14 @@ class SimView:
                 f"/sim/ghost{i}", show_axes=False, position=(x, y, 0.0), wxyz=yaw_wxyz(yaw))
             _fill(scene, f"/sim/ghost{i}/shape", [local], GHOST_Z, GHOST_RGB,
                   opacity=0.35)
+            outline = shapely.Polygon(local)
+            for k, (tau, alpha) in enumerate(zip(LOOK_AHEAD_S, GROWN_OPACITY)):
+                grown = outline.buffer(float(self._uncertainty.growth(tau)), quad_segs=8)
+                self._handles[f"grown{i}_{k}"] = scene.add_frame(
+                    f"/sim/grown{i}_{k}", show_axes=False, position=(x, y, 0.0),
+                    wxyz=yaw_wxyz(yaw))
+                _fill(scene, f"/sim/grown{i}_{k}/shape", [np.asarray(grown.exterior.coords)],
+                      GHOST_Z - 0.0005 * (k + 1), GHOST_RGB, opacity=alpha)
 
     def _put(self, name: str, seg: np.ndarray, rgb, px: float) -> None:
         h = self._handles.get(name)
@@ -311,6 +349,8 @@ class SimView:
             sensed, vel = sensing.offsets[m], sensing.velocities[m]
             now = sensed + vel * (f.t - sensing.t)
             self._handles[f"ghost{i}"].position = (*(c + now), 0.0)
+            for k, tau in enumerate(LOOK_AHEAD_S):
+                self._handles[f"grown{i}_{k}"].position = (*(c + now + vel * tau), 0.0)
             lines.append([c + sensed, c + now + vel * PREDICT_S])
         seg = np.zeros((len(lines), 2, 3), np.float32)
         if lines:
@@ -332,6 +372,7 @@ class SimView:
         keep = keep[:: max(1, len(keep) // PLOT_POINTS)]
         a = np.array(h)[keep]
         self.ui.steering.data = (a[:, 0], np.degrees(a[:, 1]), np.degrees(a[:, 2]))
+        self.ui.safety.data = (a[:, 0], a[:, 4], a[:, 5], a[:, 6])
         a = a[np.isfinite(a[:, 3])]  # no error before the first plan; uPlot cannot scale NaN
         if len(a):
             self.ui.lateral.data = (a[:, 0], 100.0 * a[:, 3])
@@ -343,7 +384,8 @@ class SimView:
             sm = run.summary
             end = (f"goal reached at t = {sm['time_to_goal_s']:.2f} s" if sm["reached_goal"]
                    else f"goal not reached in {sm['duration_s']:.1f} s")
-            text = f"Simulation: **done** — {end}, {sm['collisions']} collisions"
+            text = (f"Simulation: **done** — {end}, {sm['collisions']} collisions "
+                    f"({sm['collisions_moving']} moving, {sm['collisions_at_rest']} at rest)")
         elif not run.running:
             text = "Simulation: **stopped**"
         else:
@@ -356,6 +398,7 @@ class SimView:
         self.ui.metrics.content = "\n".join([
             f"| t | {f.t:.2f} s |", "|---|---|",
             f"| speed | {f.v:.2f} m/s |",
+            f"| guard | {f.guard} |",
             f"| cycles | {f.cycles} |",
             f"| replans | {f.replans} |",
             f"| cycle ms (last, p50) | {f.cycle_ms:.1f}, {np.median(ms):.1f} |",

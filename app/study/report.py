@@ -49,7 +49,9 @@ KINDS = {
         ("nodes", "nodes"), ("min_clearance_m", "minimum clearance (m)")),
         ("cost", "median cost (m; timing optimal: s)"), "cost"),
     "simulate": Kind("reached", "goal reached", (
-        ("collisions", "collisions"), ("min_clearance_m", "minimum clearance (m)"),
+        ("collisions", "collisions"), ("collisions_moving", "collisions while moving"),
+        ("collisions_at_rest", "collisions at rest"),
+        ("min_clearance_m", "minimum clearance (m)"),
         ("time_to_goal_s", "time to goal (s)"), ("cycle_p99_ms", "cycle time p99 (ms)"),
         ("max_lateral_error_m", "largest lateral error (m)"), ("replans", "replans")),
         ("min_clearance_m", "median minimum clearance (m)"), "collisions"),

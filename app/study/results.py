@@ -18,13 +18,14 @@ from pathlib import Path
 
 __all__ = ["COLUMNS", "TABLES", "Results", "StudyMismatch", "runs_csv"]
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2  # 2: sim_runs splits collisions into the car's (moving) and at rest
 KEY = ("scenario", "planner", "steering", "parameters", "budget_iterations", "budget_time_s",
        "seed")
 OUTCOME = ("solved", "cost", "time_to_first_solution_s", "iterations", "nodes",
            "collision_checks", "min_clearance_m", "iterations_per_s", "wall_s", "error")
 SIM_KEY = ("scenario", "parameters", "seed")
-SIM_OUTCOME = ("reached", "collisions", "min_clearance_m", "time_to_goal_s", "cycle_p50_ms",
+SIM_OUTCOME = ("reached", "collisions", "collisions_moving", "collisions_at_rest",
+               "min_clearance_m", "time_to_goal_s", "cycle_p50_ms",
                "cycle_p99_ms", "replans", "emergency_stops", "max_lateral_error_m", "wall_s",
                "error")
 COLUMNS = {"plan": ("id", "study", *KEY, *OUTCOME, "trackstar_version", "finished_at"),
@@ -52,7 +53,7 @@ CREATE INDEX IF NOT EXISTS cost_over_time_run ON cost_over_time (run_id);
 CREATE TABLE IF NOT EXISTS sim_runs (
     id INTEGER PRIMARY KEY, study TEXT NOT NULL, scenario TEXT NOT NULL,
     parameters TEXT NOT NULL, seed INTEGER NOT NULL, reached INTEGER, collisions INTEGER,
-    min_clearance_m REAL, time_to_goal_s REAL, cycle_p50_ms REAL, cycle_p99_ms REAL,
+    collisions_moving INTEGER, collisions_at_rest INTEGER, min_clearance_m REAL, time_to_goal_s REAL, cycle_p50_ms REAL, cycle_p99_ms REAL,
     replans INTEGER, emergency_stops INTEGER, max_lateral_error_m REAL, wall_s REAL,
     error TEXT, trackstar_version TEXT NOT NULL, finished_at TEXT NOT NULL,
     UNIQUE (study, scenario, parameters, seed));
@@ -77,6 +78,7 @@ class Results:
         self._db = sqlite3.connect(self.path, isolation_level=None)
         self._db.execute("PRAGMA journal_mode = WAL")
         self._db.execute("PRAGMA foreign_keys = ON")
+        _migrate(self._db)
         self._db.executescript(_SCHEMA)
         other = self._db.execute("SELECT name FROM study WHERE name != ?", (study,)).fetchone()
         if other is not None:
@@ -121,6 +123,15 @@ class Results:
 
     def close(self) -> None:
         self._db.close()
+
+
+def _migrate(db: sqlite3.Connection) -> None:
+    """Bring a results file of an older schema up to date (columns added, none removed)."""
+    old = db.execute("PRAGMA user_version").fetchone()[0]
+    has_sim = db.execute("SELECT 1 FROM sqlite_master WHERE name = 'sim_runs'").fetchone()
+    if has_sim and old < 2:
+        for column in ("collisions_moving", "collisions_at_rest"):
+            db.execute(f"ALTER TABLE sim_runs ADD COLUMN {column} INTEGER")
 
 
 def _now() -> str:

@@ -89,6 +89,8 @@ def _simulate(scenario: planner.Scenario, run: SimRun) -> tuple[dict, list]:
     problem = planner.compile_problem(scenario)
     s = simulate(problem.scenario, run.options().settings(), problem).summary
     return {"reached": int(s["reached_goal"]), "collisions": s["collisions"],
+            "collisions_moving": s["collisions_moving"],
+            "collisions_at_rest": s["collisions_at_rest"],
             "min_clearance_m": s["min_clearance_m"], "time_to_goal_s": s["time_to_goal_s"],
             "cycle_p50_ms": s["cycle_ms"]["p50"], "cycle_p99_ms": s["cycle_ms"]["p99"],
             "replans": s["replans"], "emergency_stops": s["emergency_stops"],

@@ -23,7 +23,7 @@ from planner.options import PlanOptions
 from planner.problem import Problem
 from planner.rrt import Planner
 from planner.sim.control import Reference
-from planner.sim.predict import predicted_world
+from planner.sim.predict import Uncertainty, predicted_world
 from planner.sim.sensing import Sensing
 from planner.timing import fastest_schedule
 
@@ -40,6 +40,8 @@ PRUNE_FACTOR, PRUNE_SLACK = 1.5, 2.0
 # Timing optimal: the car waits for movers on its path if it can go on within this long;
 # otherwise it plans round them, as with constant timing.
 PATIENCE_S = 10.0
+# A planned stop stands where the prediction keeps at least this clearance, checked this often.
+REST_CLEARANCE, REST_STEP = 0.1, 0.25
 
 
 @dataclass(frozen=True)
@@ -60,13 +62,14 @@ class Replanner:
 
     def __init__(self, problem: Problem, options: PlanOptions, *, seed: int,
                  budget_s: float | None, iterations: int | None, margin: float,
-                 horizon_s: float = 4.0) -> None:
+                 uncertainty: Uncertainty = Uncertainty(), horizon_s: float = 4.0) -> None:
         self.problem = problem
         self.options = options.resolved(problem)
         self.seed = seed
         self.budget_s = budget_s
         self.iterations = iterations
         self.margin = margin
+        self.uncertainty = uncertainty
         self.horizon_s = horizon_s
         self.planner: Planner | None = None
         self.attached = False  # the reference from root_s on is the planner's best path
@@ -90,7 +93,7 @@ class Replanner:
         a = self.problem.scenario.vehicle.max_accel
         commit = max(v, 0.0) * lead_s + 0.5 * a * lead_s ** 2 if v > 1e-9 else 0.0
         root, anchor, skip, s_c = self._commit_point(pose, s_now, commit)
-        believed = predicted_world(self.problem.world, sensing, t + lead_s)
+        believed = predicted_world(self.problem.world, sensing, t + lead_s, self.uncertainty)
         plan_world = inflated(believed, self.margin)
         if clearance(plan_world, root[0], root[1], 0.0) <= 0.0:
             plan_world = believed  # already inside the margin: plan with the bare disc
@@ -212,8 +215,26 @@ class Replanner:
         c = path_clearances(believed, samples, True)
         hit = np.flatnonzero(c <= 0.02)
         if len(hit):
-            return float(ref.s[i0 + hit[0]]) - 0.15, True
+            # Wait where no predicted mover comes while the car stands: the last row before
+            # the conflict that stays clear from its arrival to the horizon's end.
+            rest = self._rest_clearances(believed, samples[:hit[0]])
+            ok = np.flatnonzero(rest > REST_CLEARANCE)
+            last = ok[-1] if len(ok) else 0
+            return float(ref.s[i0 + last]) - (0.15 if len(ok) else 0.0), True
         return ref.length, False
+
+    def _rest_clearances(self, believed, samples: np.ndarray) -> np.ndarray:
+        """Per row, the least clearance of the car standing there from its arrival (column 5)
+        on, at instants `REST_STEP` s apart up to the horizon."""
+        out = np.full(len(samples), np.inf)
+        rest = samples.copy()
+        for tau in np.arange(0.0, self.horizon_s + REST_STEP / 2, REST_STEP):
+            later = samples[:, 5] <= tau
+            if not later.any():
+                continue
+            rest[:, 5] = tau
+            out[later] = np.minimum(out[later], path_clearances(believed, rest[later], True))
+        return out
 
 
 _warm = False

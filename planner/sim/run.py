@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from planner._world import path_clearances
+from planner._world import clearance, inflated, path_clearances
 from planner.options import TIMINGS, PlanOptions
 from planner.problem import Problem, compile_problem, resolve_track
 from planner.rrt import warm_up
@@ -24,8 +24,10 @@ from planner.scenario import Scenario
 from planner.sim.control import CONTROLLERS, Reference, Tracking, steer_command
 from planner.sim.fsm import Machine
 from planner.sim.fsm.runtime import Behaviour
+from planner.sim.guard import BACK_OFF, FOLLOW, STAND, UNSTICK_S, Decision, guard
 from planner.sim.laps import LapCounter, require_track
-from planner.sim.metrics import collision_runs, cycle_stats
+from planner.sim.metrics import AT_REST, MOVING, collision_runs, contacts, cycle_stats
+from planner.sim.predict import Uncertainty, predicted_world
 from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
 from planner.sim.sensing import Sensing, mover_index, sense, true_offsets
@@ -56,6 +58,21 @@ class SimSettings:
     timing: str = "constant"  # optimal: the car may stop for a mover instead of going round
     laps: int | None = None  # lap mode: drive this many laps of the scenario's closed track
     goal_ahead: float = 3.0  # m of centreline arc between the car and its rolling goal (laps)
+    # The movers' prediction (`Uncertainty`); None: the scenario's `prediction`, else the default.
+    predict_accel: float | None = None  # m/s²: how fast a mover may change its velocity
+    predict_speed_error: float | None = None  # m/s: error of a sensed velocity
+    predict_horizon: float | None = None  # s over which the predictions widen
+    reverse: bool = True  # the car may back up to evade
+
+    def uncertainty(self, scenario: Scenario | None = None) -> Uncertainty:
+        """The prediction's parameters: these settings', else the scenario's, else defaults."""
+        p = scenario.prediction if scenario is not None else None
+        pick = {name: value for name, value in (
+            ("accel", self.predict_accel), ("speed_error", self.predict_speed_error),
+            ("horizon", self.predict_horizon)) if value is not None}
+        given = {k: v for k, v in (p.model_dump() if p is not None else {}).items()
+                 if v is not None}
+        return Uncertainty(**{**given, **pick})
 
     def __post_init__(self) -> None:
         for name in ("duration", "rate", "control_rate", "sense_rate"):
@@ -76,6 +93,7 @@ class SimSettings:
                 math.isfinite(self.fixed_latency_ms) and self.fixed_latency_ms >= 0):
             raise ValueError(f"--fixed-latency must be a finite number >= 0, "
                              f"got {self.fixed_latency_ms}")
+        self.uncertainty()  # checks the prediction's parameters
 
 
 @dataclass
@@ -114,12 +132,46 @@ class Frame:
     cycles: int
     replans: int
     cycle_ms: float  # wall time of the latest cycle (NaN before the first)
+    guard: str = "follow"  # what the guard has the car do: a key of `GUARD_CODES`
 
 
 def _in_goal(problem: Problem, x: float, y: float, th: float) -> bool:
     gx, gy, gth = problem.goal
     return (math.hypot(x - gx, y - gy) <= problem.goal_position_tol
             and abs(math.remainder(th - gth, 2.0 * math.pi)) <= problem.goal_heading_tol)
+
+
+# The guard keeps this share of the planning margin for tracking errors: the plans, made with
+# all of it, pass its check with room to spare.
+GUARD_MARGIN = 0.5
+STUCK_S = 2.0  # s at rest, not by plan, before the car backs off once (`guard.BACK_OFF`)
+# Per-tick guard codes in the log's ``guard`` column.
+GUARD_CODES = {"follow": 0, "wait": 1, "slow": 2, "brake": 3, "evade": 4, "back-off": 5}
+
+
+def _state(decision: Decision | None, waiting: bool) -> str:
+    """What the guard has the car do, as the log's ``guard`` column names it."""
+    if waiting:
+        return "wait"
+    if decision is None or decision.manoeuvre.name in (FOLLOW, STAND):
+        return "follow"
+    if decision.on_plan or not decision.danger:
+        return decision.manoeuvre.name
+    return "evade"
+
+
+def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertainty,
+            s: SimSettings,
+            limits: Limits, state, ref: Reference | None, stop_s: float, cruise: float,
+            commit: float, stuck: bool) -> Decision:
+    """The guard's decision at a cycle's start, in the world the car believes in now (grown
+    predictions, the planning margin; the bare car where it already is inside the margin)."""
+    believed = predicted_world(problem.world, sensing, t, uncertainty)
+    margin = GUARD_MARGIN * s.margin
+    margin = margin if clearance(believed, state[0], state[1], 0.0) > margin else 0.0
+    i = ref.project(state[0], state[1])[0] if ref is not None else 0
+    return guard(inflated(believed, margin), margin, state, limits, ref, i, stop_s, cruise,
+                 commit, problem.rho, s.reverse, stuck)
 
 
 def _lap_counter(scenario: Scenario, problem: Problem, s: SimSettings, load_track):
@@ -155,6 +207,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     movers = mover_index(scenario)
     rng = np.random.default_rng(s.seed)
     fixed = s.fixed_latency_ms / 1000.0 if s.fixed_latency_ms is not None else None
+    uncertainty = s.uncertainty(scenario)
     def new_replanner() -> Replanner:
         # No polishing: a cycle's budget is a few milliseconds, and the next cycle replans.
         return Replanner(problem, PlanOptions(seed=s.seed, polish=False, timing=s.timing,
@@ -162,7 +215,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                          seed=s.seed,
                          budget_s=s.budget_share / s.rate,
                          iterations=s.iterations if fixed is not None else None,
-                         margin=s.margin)
+                         margin=s.margin, uncertainty=uncertainty)
 
     fsm = Behaviour(behaviour, problem.world, limits.wheelbase, dt) if behaviour else None
     # FollowTrack caps its own speed; timing optimal drives as fast as the car may.
@@ -180,6 +233,11 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     pending, next_cycle = None, 0.0 if fsm is None or fsm.planning else math.inf
     walls, cycles, replans, stops, waits, was_stopped = [], [], 0, 0, 0, False
     planned = False  # the current stop is a planned wait (timing optimal), not an emergency
+    # The guard's decision (FOLLOW until the first): what the car does until the next cycle.
+    guarded = fsm is None and s.replan
+    decision, decided_at, codes, evasions, brakes = None, 0.0, [], 0, 0
+    planless_since = backed_at = 0.0  # since when the car has stood without a way on
+    backed_off = False
     rows, lat = [], []
     tree_of, tree = None, None  # the planner last shown to the observer, and its copy
     wall0 = time.perf_counter()
@@ -205,13 +263,36 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                 s.replan or ref is None or counter is not None):
             if counter is not None:
                 replanner.aim(counter.goals())
-            s_now = ref.s[ref.project(est[0], est[1])[0]] if ref is not None else 0.0
             lead = max(1.0 / s.rate, fixed if fixed is not None else
                        (walls[-1] if walls else 0.0))
+            checked = time.perf_counter()
+            if guarded:
+                before = decision
+                backing = (before is not None and before.manoeuvre.name == BACK_OFF
+                           and t - backed_at < UNSTICK_S)  # a back-off runs its course
+                if planned or (abs(v) > 1e-9 and not backing):
+                    planless_since = t  # not stuck: waiting by plan, or driving
+                    backed_off = backed_off and v <= 0.0
+                decision = _decide(problem, sensing, t, uncertainty, s, limits, (*est, v, steer),
+                                   ref, stop_s, cruise, lead,
+                                   backing or (not backed_off
+                                               and t - planless_since >= STUCK_S))
+                decided_at = t
+                if decision.manoeuvre.name == BACK_OFF and not backing:
+                    backed_at, backed_off = t, True  # once, until the car drives on again
+                brakes += decision.manoeuvre.name == "brake" and (
+                    before is None or before.manoeuvre.name != "brake")
+                evasions += not decision.on_plan and decision.danger and (
+                    before is None or before.on_plan or not before.danger)
+                if not decision.on_plan and ref is not None:  # off the plan: plan afresh
+                    replanner, ref, conflict = new_replanner(), None, False
+            checked = time.perf_counter() - checked
+            s_now = ref.s[ref.project(est[0], est[1])[0]] if ref is not None else 0.0
             cyc = replanner.cycle(t, sensing, est, v, s_now, lead)
-            latency = fixed if fixed is not None else cyc.wall_s
+            latency = fixed if fixed is not None else cyc.wall_s + checked
             walls.append(latency)
-            cycles.append({"t": t, "ms": cyc.wall_s * 1000.0, "replaced": cyc.replaced,
+            cycles.append({"t": t, "ms": (cyc.wall_s + checked) * 1000.0,
+                           "replaced": cyc.replaced,
                            "nodes": cyc.nodes})
             pending = (t + max(1.0 / s.rate, latency), cyc)
             next_cycle = pending[0]
@@ -222,9 +303,14 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
             room = stop_s - ref.s[i] if (s.replan or not conflict) else math.inf
             if not s.replan:
                 room = ref.length - ref.s[i]
-            want_v = min(cruise, math.sqrt(2.0 * limits.max_accel * max(room, 0.0)))
+            cap = cruise if decision is None else min(cruise, decision.manoeuvre.speed)
+            want_v = min(cap, math.sqrt(2.0 * limits.max_accel * max(room, 0.0)))
             want_steer = steer_command(s.controller, ref, i, e, e_old, est, v,
                                        limits.wheelbase, dt, gains)
+        if decision is not None and not decision.on_plan:  # the guard's manoeuvre
+            m = decision.manoeuvre
+            want_v = m.speed if t - decided_at < m.hold else 0.0
+            want_steer = m.steer
         if fsm is not None:  # the state machine drives; FollowTrack passes the plan on
             want_v, want_steer = fsm.step(t, (x, y, th), est, v, steer,
                                           (want_v, want_steer) if ref is not None else None)
@@ -233,9 +319,13 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                 next_cycle = t + dt if fsm.planning else math.inf
         v_cmd, steer_cmd = limit_commands(v, steer, want_v, want_steer, limits, dt)
         e_old = e
-        stopped = ref is not None and conflict and abs(v_cmd) < 1e-9
-        stops += stopped and not was_stopped and not planned
-        waits += stopped and not was_stopped and planned
+        guarding = decision is not None and decision.manoeuvre.name not in (FOLLOW, STAND)
+        stopped = abs(v_cmd) < 1e-9 and ((ref is not None and conflict) or guarding)
+        planned_now = planned and not guarding
+        stops += stopped and not was_stopped and not planned_now
+        waits += stopped and not was_stopped and planned_now
+        state = _state(decision, planned_now and stopped)
+        codes.append(GUARD_CODES[state])
         was_stopped = stopped
         rows.append((t, x, y, th, v_cmd, steer_cmd, want_steer, e,
                      replanner.planner.nodes if replanner.planner else 0))
@@ -247,7 +337,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
             observer(Frame(t, (x, y, th), v_cmd, steer_cmd, want_steer, e,
                            true_offsets(problem.world, movers, t)[0], sensing, ref,
                            tree, len(cycles), int(replans),
-                           cycles[-1]["ms"] if cycles else math.nan))
+                           cycles[-1]["ms"] if cycles else math.nan, state))
         v, steer = v_cmd, steer_cmd
         if counter is not None:
             counter.update(t, x, y)
@@ -272,19 +362,25 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     lat = lat[np.isfinite(lat)]
     columns = ["t", "x", "y", "theta", "v", "steer"]
     columns += [f"obs{i}_{a}" for i in range(len(movers)) for a in ("dx", "dy")]
-    columns += ["steer_set", "lateral_error", "tree_nodes", "clearance"]
-    table = np.column_stack([log[:, :6], offsets.reshape(len(log), -1), log[:, 6:], clear])
+    contact = contacts(clear, log[:, 4])
+    columns += ["steer_set", "lateral_error", "tree_nodes", "clearance", "contact", "guard"]
+    table = np.column_stack([log[:, :6], offsets.reshape(len(log), -1), log[:, 6:], clear,
+                             contact, codes])
     summary = {
         "reached_goal": reached,
         "time_to_goal_s": float(log[-1, 0]) if reached else None,
         "duration_s": float(log[-1, 0]),
         "collisions": collision_runs(clear),
+        "collisions_moving": collision_runs(np.where(contact == MOVING, -1.0, 1.0)),
+        "collisions_at_rest": collision_runs(np.where(contact == AT_REST, -1.0, 1.0)),
         "min_clearance_m": float(clear.min()),
         "cycles": len(walls),
         "replans": int(replans),
         **cycle_stats(walls),
         "emergency_stops": int(stops),
         "planned_waits": int(waits),
+        "brakes": int(brakes),
+        "evasions": int(evasions),
         "cross_track_error_m": {"mean": float(lat.mean()) if len(lat) else None,
                                 "max": float(lat.max()) if len(lat) else None},
         "distance_m": float(np.abs(log[:, 4]).sum() * dt) - float(abs(log[-1, 4]) * dt),

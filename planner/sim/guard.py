@@ -1,0 +1,222 @@
+"""Safety before optimality: every cycle, check what the car commits to and fall back in time.
+
+A state is safe when some manoeuvre from it stays clear of the grown predictions
+(`planner.sim.predict`) and of the static world over the whole check horizon, the car at rest at
+its end — the idea of inevitable collision states (Fraichard & Asama 2004) with passive safety
+(Bouraine et al. 2012): a car that must ever be hit should be hit at rest, and a car at rest
+should stand where no predicted mover comes before it has left.
+
+Each cycle the guard tries, fastest first, to go on along the plan at a speed cap for one
+cycle (the commitment) followed by a fallback: brake along the plan, or drive on along it for a
+while and brake then. The first cap with a clear fallback is what the car drives. If none is
+clear, the car is in danger: the guard picks, from the state now, the manoeuvre that stays
+clear longest — brake along the plan, brake while swerving, swerve at speed, go on straight, or
+back up — and the car executes it until the next cycle decides again.
+
+Rollouts are the car's own model (`vehicle.arc_step` with the actuator limits, at
+``STEP`` s); along the plan the car is where the reference is at the driven arc (it tracks it to
+a few cm, within the planning margin). Between two samples k and k + 1 the clearance drops by at
+most (|v|·(1 + reach/ρ) + the movers' top speed and growth)·STEP, so two samples whose
+clearances add up to more than that cannot hide a contact between them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from planner._world import (CONTACT, REACH, VMAX_OBS, World, path_clearances,
+                            path_moving_clearances)
+from planner.sim.control import Reference
+from planner.sim.vehicle import Limits
+
+__all__ = ["BACK_OFF", "FOLLOW", "STAND", "Decision", "Manoeuvre", "guard"]
+
+STEP = 0.02  # s between rollout samples
+HORIZON = 4.0  # s checked ahead, the car at rest at its end
+CAPS = (1.0, 0.5, 0.0)  # commit speed caps, as shares of the cruise speed, tried in order
+GO_ON = (0.0, 1.0, 2.0)  # s driven on along the plan after the commitment before braking
+EVADE_S = 1.0  # s an evasive manoeuvre holds its speed before it brakes
+FOLLOW, STAND = "follow", "stand"  # along the plan at cruise; no plan: at rest where it is
+BACK_OFF, UNSTICK_S = "back-off", 2.0  # stuck: back up at half the cruise speed this long
+
+
+@dataclass(frozen=True)
+class Manoeuvre:
+    """Commands held from the decision on: a speed target for ``hold`` s then 0, and a steering
+    target (None: track the plan, the speed capped at ``speed``)."""
+
+    name: str
+    speed: float
+    hold: float = math.inf
+    steer: float | None = None
+
+
+class Outcome(NamedTuple):
+    """How a rollout fares: clear for ``clear_s`` (inf: the whole horizon), and whether the car
+    stands still where it may first be hit (passive safety: then the contact is not its own)."""
+
+    clear_s: float
+    at_rest: bool
+
+    @property
+    def rank(self):
+        """Clear throughout first, then at rest when hit, then clear for longest."""
+        return (self.clear_s == math.inf, self.at_rest, self.clear_s)
+
+
+@dataclass(frozen=True)
+class Decision:
+    """What the car does until the next cycle. ``clear_s``: how long the chosen manoeuvre
+    stays clear (inf: over the whole horizon); ``danger``: no commitment along the plan was
+    clear, so this is an evasive choice."""
+
+    manoeuvre: Manoeuvre
+    clear_s: float
+    danger: bool
+
+    @property
+    def on_plan(self) -> bool:
+        return self.manoeuvre.steer is None
+
+
+class _Rollouts:
+    """Rollouts from one state against one believed world (planner time 0 = the decision)."""
+
+    def __init__(self, world: World, margin: float, state, limits: Limits,
+                 ref: Reference | None, i: int, stop_s: float, rho: float) -> None:
+        self.world, self.margin, self.limits, self.ref, self.stop_s = (world, margin, limits,
+                                                                      ref, stop_s)
+        self.x, self.y, self.th, self.v, self.steer = state
+        self.s0 = float(ref.s[i]) if ref is not None else 0.0
+        self.n = int(round(HORIZON / STEP)) + 1
+        self.t = np.arange(self.n) * STEP
+        # How fast the believed movers close in, per sample: their speed, plus their
+        # growth's rate while it widens (`planner._world.growth`; held beyond its horizon).
+        e, e_v, a, age, horizon = (world.m_grow[0] if len(world.m_grow) else np.zeros(5))
+        tau = self.t[:-1] + age
+        widening = np.where(tau < horizon, e_v + a * np.maximum(tau, 0.0), 0.0)
+        self.closing = (world.geo[VMAX_OBS] - (e_v + a * horizon) + widening) * STEP
+        self.reach = 1.0 + world.geo[REACH] / rho
+
+    def along(self, cap: float, hold: float) -> Outcome:
+        """Clear time of: along the plan at speed ``cap`` for ``hold`` s, then braking; never
+        past ``stop_s``."""
+        ref, a = self.ref, self.limits.max_accel
+        v, s = self.v, self.s0
+        vs, ss = np.empty(self.n), np.empty(self.n)
+        for k in range(self.n):
+            vs[k], ss[k] = v, s
+            tk = k * STEP
+            want = cap if tk < hold else 0.0
+            want = min(want, math.sqrt(2.0 * a * max(self.stop_s - s, 0.0)))
+            nv = _toward(v, want, a * STEP)
+            s += 0.5 * (v + nv) * STEP
+            v = nv
+        j = np.clip(np.searchsorted(ref.s, ss) - 1, 0, len(ref.s) - 2)
+        u = np.clip((ss - ref.s[j]) / np.maximum(ref.s[j + 1] - ref.s[j], 1e-12), 0.0, 1.0)
+        poses = np.empty((self.n, 3))
+        poses[:, :2] = ref.rows[j, :2] + u[:, None] * (ref.rows[j + 1, :2] - ref.rows[j, :2])
+        poses[:, 2] = np.where(u < 0.5, ref.rows[j, 2], ref.rows[j + 1, 2])
+        return self._clear(poses, vs)
+
+    def free(self, m: Manoeuvre) -> Outcome:
+        """Clear time of an open-loop manoeuvre: steering towards ``m.steer`` at the rate
+        limit, speed towards ``m.speed`` for ``m.hold`` s, then braking."""
+        lim = self.limits
+        vs = np.empty(self.n)
+        steers = np.clip(m.steer, self.steer - lim.max_steer_rate * self.t,
+                         self.steer + lim.max_steer_rate * self.t)
+        v = self.v
+        for k in range(self.n):
+            vs[k] = v
+            v = _toward(v, m.speed if k * STEP < m.hold else 0.0, lim.max_accel * STEP)
+        # Exact arcs per step (commands held over it, as the car does).
+        v_mid = 0.5 * (vs[:-1] + vs[1:])
+        dth = v_mid * STEP * np.tan(steers[:-1]) / lim.wheelbase
+        th = self.th + np.concatenate([[0.0], np.cumsum(dth)])
+        chord = v_mid * STEP * np.sinc(dth / (2.0 * np.pi))
+        mid = th[:-1] + 0.5 * dth
+        poses = np.empty((self.n, 3))
+        poses[:, 0] = self.x + np.concatenate([[0.0], np.cumsum(chord * np.cos(mid))])
+        poses[:, 1] = self.y + np.concatenate([[0.0], np.cumsum(chord * np.sin(mid))])
+        poses[:, 2] = th
+        return self._clear(poses, vs)
+
+    def _clear(self, poses: np.ndarray, vs: np.ndarray) -> Outcome:
+        """The time of the first sample pair that may hide a contact (inf: none): with the
+        movers as believed (grown, with the margin), with the static world as it is."""
+        samples = np.zeros((self.n, 6))
+        samples[:, :3] = poses
+        samples[:, 5] = self.t
+        moving = path_moving_clearances(self.world, samples)
+        samples[:, 5] = math.nan  # static obstacles only
+        static = path_clearances(self.world, samples, True) + self.margin
+        drive = np.abs(vs[:-1]) * self.reach * STEP
+        bad = np.flatnonzero(_unsure(moving, drive + self.closing) | _unsure(static, drive))
+        if len(bad) == 0:
+            return Outcome(math.inf, True)
+        k = bad[0]
+        return Outcome(float(self.t[k]), max(abs(vs[k]), abs(vs[k + 1])) < 1e-9)
+
+
+def _unsure(c: np.ndarray, drop: np.ndarray) -> np.ndarray:
+    """Per sample pair: may the clearance reach contact between them?"""
+    return (c[:-1] <= CONTACT) | (c[:-1] + c[1:] <= drop + 2.0 * CONTACT)
+
+
+def _toward(v: float, want: float, step: float) -> float:
+    return want if abs(want - v) <= step else v + math.copysign(step, want - v)
+
+
+def guard(world: World, margin: float, state, limits: Limits, ref: Reference | None, i: int,
+          stop_s: float, cruise: float, commit: float, rho: float, reverse: bool,
+          stuck: bool = False) -> Decision:
+    """The car's manoeuvre until the next decision, ``commit`` s from now.
+
+    ``state``: (x, y, θ, v, δ) now; ``ref``/``i``: the plan and the car's row on it (None: no
+    plan yet); ``stop_s``: the arc where the plan wants the car at rest (a planned wait or the
+    plan's end); ``world``: the grown prediction with planner time 0 now, inflated by
+    ``margin`` (which the static check gives back: the car may come as near a wall as it is);
+    ``stuck``: the car has stood, not by plan, for a while — a forward-only planner finds no
+    way round an obstacle right in front, so it backs off a little if that is clear.
+    """
+    r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho)
+    tried: list[tuple[Outcome, Manoeuvre]] = []
+    if stuck and reverse:  # a forward-only plan finds no way on: make room behind
+        m = Manoeuvre(BACK_OFF, -0.5 * cruise, steer=0.0)
+        out = r.free(m)
+        if out.clear_s == math.inf:
+            return Decision(m, out.clear_s, False)
+    if ref is not None:
+        for share in CAPS:
+            m = Manoeuvre(FOLLOW if share == 1.0 else "slow" if share > 0 else "brake",
+                          share * cruise)
+            for go_on in GO_ON if share > 0.0 else (0.0,):
+                out = r.along(m.speed, commit + go_on)
+                if out.clear_s == math.inf:
+                    return Decision(m, out.clear_s, False)
+                tried.append((out, m))
+    else:  # no plan: standing (or braking) where it is, if that is clear
+        m = Manoeuvre(STAND, 0.0, steer=state[4])
+        out = r.free(m)
+        if out.clear_s == math.inf:
+            return Decision(m, out.clear_s, False)
+        tried.append((out, m))
+    s_max = limits.max_steer
+    evasive = [Manoeuvre("brake-left", 0.0, steer=s_max),
+               Manoeuvre("brake-right", 0.0, steer=-s_max),
+               Manoeuvre("swerve-left", max(r.v, 0.5 * cruise), EVADE_S, s_max),
+               Manoeuvre("swerve-right", max(r.v, 0.5 * cruise), EVADE_S, -s_max),
+               Manoeuvre("go-on", limits.max_speed, EVADE_S, 0.0)]
+    if reverse:
+        evasive += [Manoeuvre("back-up", -cruise, EVADE_S, 0.0),
+                    Manoeuvre("back-up-left", -cruise, EVADE_S, s_max),
+                    Manoeuvre("back-up-right", -cruise, EVADE_S, -s_max)]
+    for m in evasive:
+        tried.append((r.free(m), m))
+    out, m = max(tried, key=lambda om: om[0].rank)  # the first of the best
+    return Decision(m, out.clear_s, True)

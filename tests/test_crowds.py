@@ -1,0 +1,174 @@
+"""Safety among crowds (issue 30): grown predictions, the guard, the crowd scenes, the split of
+collisions into the car's own (moving) and those it suffered at rest."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import planner
+from checker import first_collision, pose_valid
+from conftest import scenario_dict
+from planner._world import build_world, moving_clearance
+from planner.sim import SimSettings, simulate
+from planner.sim.metrics import AT_REST, MOVING, contacts
+from planner.sim.predict import Uncertainty, predicted_world
+from planner.sim.sensing import Sensing
+
+CROWDS = ("crowd_crossing", "crowd_warehouse", "crowd_merge", "crowd_square", "crowd_overtake")
+
+
+# -- the scenes are fair ---------------------------------------------------------------------
+@pytest.mark.parametrize("name", CROWDS)
+def test_waiting_at_the_start_is_collision_free(name):
+    """Against the true motions, every 10 ms of a minute (independent checker)."""
+    scn = scenario_dict(name)
+    x, y, th = scn["start"]
+    hits = [t for t in np.arange(0.0, 60.0, 0.01) if not pose_valid(scn, x, y, t, th)]
+    assert not hits, f"{name}: a mover reaches the start at t = {hits[0]:.2f} s"
+
+
+@pytest.mark.parametrize("name", CROWDS)
+def test_a_collision_free_schedule_to_the_goal_exists(name):
+    """A space-time plan among the true motions, checked every 5 mm by the independent
+    checker: a car that knew the future could get there without touching anyone."""
+    scn = scenario_dict(name)
+    result = planner.solve(name, time_limit=2.0, seed=0)
+    assert result.solved, name
+    path = np.asarray(result.path)
+    assert first_collision(scn, path[:, [0, 1, 2, 5]]) is None
+    assert planner.load_scenario(name).description  # each says what it is
+
+
+# -- predictions with uncertainty ------------------------------------------------------------
+@settings(max_examples=60, deadline=None)
+@given(tau=st.floats(0.0, 5.0), accel=st.floats(0.0, 3.0), error=st.floats(0.0, 0.5),
+       horizon=st.floats(0.0, 3.0), vx=st.floats(-2.0, 2.0), age=st.floats(0.0, 0.2))
+def test_a_predicted_disc_grows_with_the_look_ahead(tau, accel, error, horizon, vx, age):
+    """The grown prediction is the constant-velocity disc grown by e_v·τ + ½·a·τ², τ the time
+    since the sensing, held at the horizon."""
+    world = build_world((-50, -50, 50, 50), 0.0, [(0.0, 0.0, 0.5, 0)], [],
+                        [("velocity", (0.0, 0.0))])
+    sensing = Sensing(0.0, np.array([[1.0, 0.0]]), np.array([[vx, 0.0]]))
+    u = Uncertainty(accel, error, horizon)
+    grown = predicted_world(world, sensing, age, u)
+    centre = 1.0 + vx * (age + tau)
+    look = min(age + tau, horizon)
+    expected = abs(10.0 - centre) - 0.5 - (error * look + 0.5 * accel * look ** 2)
+    assert moving_clearance(grown, 10.0, 0.0, 0.0, tau) == pytest.approx(expected, abs=1e-9)
+
+
+@pytest.mark.parametrize("bad", [{"accel": -1.0}, {"speed_error": math.nan},
+                                 {"horizon": math.inf}])
+def test_uncertainty_rejects_negative_and_non_finite_values(bad):
+    with pytest.raises(ValueError, match="--predict-"):
+        Uncertainty(**bad)
+
+
+def test_contacts_are_the_cars_when_it_moved_into_them():
+    clear = np.array([1.0, -0.1, -0.2, 0.5, 0.4, -0.1, -0.2, 1.0])
+    speeds = np.array([1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.8, 0.8])
+    assert list(contacts(clear, speeds)) == [0, MOVING, MOVING, 0, 0, AT_REST, AT_REST, 0]
+
+
+# -- the car among movers --------------------------------------------------------------------
+def test_the_car_no_longer_stops_in_a_crossing_lane():
+    """The issue's case: movers, seed 0, timing optimal, 30 Hz: the car braked to rest in the
+    lane of the 1 m disc and was run over (clearance −0.13 m for 1.1 s)."""
+    run = simulate(planner.load_scenario("movers"),
+                   SimSettings(rate=30, timing="optimal", seed=0, fixed_latency_ms=20))
+    s = run.summary
+    assert s["collisions"] == 0 and s["reached_goal"], s
+    assert s["min_clearance_m"] > 0
+
+
+@pytest.mark.parametrize("name", CROWDS + ("movers",))
+@pytest.mark.parametrize("timing", ["constant", "optimal"])
+def test_no_collision_among_crowds(name, timing):
+    """Fair scenes (waiting at the start is free): no contact of any kind, and the goal."""
+    run = simulate(planner.load_scenario(name),
+                   SimSettings(rate=10, timing=timing, seed=1, fixed_latency_ms=20))
+    s = run.summary
+    assert s["collisions"] == 0, s
+    assert s["collisions_moving"] == s["collisions_at_rest"] == 0
+    col = run.columns
+    assert {"contact", "guard"} <= set(col) and not run.log[:, col.index("contact")].any()
+    assert s["reached_goal"], s
+
+
+def test_the_cli_reports_the_split_and_refuses_bad_uncertainty():
+    out = subprocess.run(["trackstar", "simulate", "crossing", "--duration",
+                          "2", "--fixed-latency", "20", "--json", "--predict-accel", "0.5"],
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    s = json.loads(out.stdout)
+    assert s["parameters"]["predict_accel"] == 0.5
+    for key in ("collisions_moving", "collisions_at_rest", "evasions", "brakes"):
+        assert key in s
+    for args in (["--predict-accel", "-1"], ["--predict-horizon", "nan"],
+                 ["--timing", "fastest"]):
+        bad = subprocess.run(["trackstar", "simulate", "crossing", *args],
+                             capture_output=True, text=True)
+        assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1, bad.stderr
+
+
+def test_the_prediction_comes_from_the_options_else_the_scenario_else_defaults():
+    """Command line and REST leave it to the scenario (None); a scenario's `prediction` fills
+    what the options leave open; the rest are `Uncertainty`'s defaults."""
+    import inspect
+
+    from app.cli._simulate import simulate as cli_simulate
+    from app.simulation import SimOptions
+
+    cli = inspect.signature(cli_simulate).parameters
+    for name in ("predict_accel", "predict_speed_error", "predict_horizon"):
+        assert cli[name].default is None and SimOptions.model_fields[name].default is None
+    raw = scenario_dict("crossing") | {"prediction": {"accel": 0.3}}
+    scn = planner.parse_scenario(raw)
+    assert SimSettings().uncertainty(scn) == Uncertainty(accel=0.3)
+    assert SimSettings(predict_accel=2.0, predict_horizon=1.0).uncertainty(scn) == Uncertainty(
+        accel=2.0, horizon=1.0)
+    assert SimSettings().uncertainty() == Uncertainty()
+    assert Uncertainty().growth(2.0) == pytest.approx(0.1 * 1.5 + 0.5 * 1.0 * 1.5 ** 2)
+    with pytest.raises(Exception, match="accel"):
+        planner.parse_scenario(scenario_dict("crossing") | {"prediction": {"accel": -1}})
+
+
+def _lane_with_a_disc_coming(vy: float):
+    """A car at rest at (5, 5) heading +x; a 0.2 m disc 2.5 m above it moving at vy."""
+    from planner.sim.vehicle import Limits
+
+    world = build_world((0, 0, 10, 10), 0.2, [(5.0, 5.0, 0.2, 0)], [],
+                        [("velocity", (0.0, 0.0))])
+    sensing = Sensing(0.0, np.array([[0.0, 2.5]]), np.array([[0.0, vy]]))
+    limits = Limits(wheelbase=0.44, max_steer=math.radians(26), max_steer_rate=math.pi,
+                    max_speed=2.0, max_accel=2.0)
+    return predicted_world(world, sensing, 0.0), limits
+
+
+@pytest.mark.parametrize("reverse", [True, False])
+def test_the_guard_leaves_a_lane_a_mover_will_cross(reverse):
+    """Standing is not safe when a disc comes down on the car: the guard picks a manoeuvre
+    that stays clear over the whole horizon, backing up only where the car may."""
+    from planner.sim.guard import guard
+
+    world, limits = _lane_with_a_disc_coming(-0.5)
+    d = guard(world, 0.025, (5.0, 5.0, 0.0, 0.0, 0.0), limits, None, 0, 0.0, 1.0, 0.1, 0.9021,
+              reverse)
+    assert d.danger and not d.on_plan and d.clear_s == math.inf, d
+    assert reverse or not d.manoeuvre.name.startswith("back")
+
+
+def test_the_guard_stands_still_when_nothing_comes():
+    from planner.sim.guard import STAND, guard
+
+    world, limits = _lane_with_a_disc_coming(+0.5)  # moving away
+    d = guard(world, 0.025, (5.0, 5.0, 0.0, 0.0, 0.0), limits, None, 0, 0.0, 1.0, 0.1, 0.9021,
+              True)
+    assert d.manoeuvre.name == STAND and not d.danger
