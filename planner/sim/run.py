@@ -153,11 +153,12 @@ def _state(decision: Decision | None, waiting: bool) -> str:
     """What the guard has the car do, as the log's ``guard`` column names it."""
     if waiting:
         return "wait"
-    if decision is None or decision.manoeuvre.name in (FOLLOW, STAND):
+    if decision is None or not decision.danger and decision.manoeuvre.name in (FOLLOW, STAND):
         return "follow"
-    if decision.on_plan or not decision.danger:
+    if not decision.danger:
         return decision.manoeuvre.name
-    return "evade"
+    # In danger: standing or braking on the plan (passive safety) is a brake, the rest evades.
+    return "brake" if decision.on_plan or decision.manoeuvre.name == STAND else "evade"
 
 
 def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertainty,
