@@ -161,8 +161,13 @@ def test_a_dead_worker_is_replaced_and_only_a_run_that_kills_workers_fails(tmp_p
             refused = crashing.result(timeout=30)
         assert refused.status_code == 422, refused.text
         assert "stops the planning worker that runs it" in refused.json()["detail"]
-        assert any("died twice running run_plan(scenario 'slalom', {" in line
-                   for line in srv.err), srv.err
+        # The server logs it before it answers, but the test's reader thread may not have read
+        # the server's stderr yet (seen once in CI): wait for the line, a little.
+        deadline = time.monotonic() + 10
+        while not any("died twice running run_plan(scenario 'slalom', {" in line
+                      for line in srv.err):
+            assert time.monotonic() < deadline, srv.err
+            time.sleep(0.1)
         assert srv.client.post("/plan", json=body).status_code == 200
     finally:
         assert srv.stop() < 5
