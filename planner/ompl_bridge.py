@@ -1,7 +1,7 @@
 """OMPL's planners on our problems: the baseline of the benchmarks and the ``ompl:*`` targets
 of studies (needs the ``bench`` extra: ``pip install 'trackstar[bench]'``).
 
-The problem is set up as ../shared/scenarios/FORMAT.md defines comparisons: Dubins (or
+The problem is set up as docs/scenario-format.md (FORMAT.md) defines comparisons: Dubins (or
 Reeds-Shepp) state space with our turning radius, poses checked every 0.02 m along motions, a
 goal region with position and heading tolerances whose one goal sample is the exact goal pose,
 path length as the objective with a cost threshold of 0 (the optimising planners use the whole
