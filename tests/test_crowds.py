@@ -172,3 +172,30 @@ def test_the_guard_stands_still_when_nothing_comes():
     d = guard(world, 0.025, (5.0, 5.0, 0.0, 0.0, 0.0), limits, None, 0, 0.0, 1.0, 0.1, 0.9021,
               True)
     assert d.manoeuvre.name == STAND and not d.danger
+
+
+def test_a_stop_in_a_movers_likely_path_ranks_below_leaving_it():
+    """Passive safety is no refuge from a walker coming straight at the car: a manoeuvre clear
+    of the likely (constant-velocity) futures beats standing where one of them arrives, and
+    among manoeuvres clear of both, the one clear of the grown predictions longer wins."""
+    from planner.sim.guard import Outcome
+
+    stop_in_path = Outcome(clear_s=0.5, at_rest=True, likely_s=1.2)
+    swerve_out = Outcome(clear_s=0.3, at_rest=False)
+    assert swerve_out.rank > stop_in_path.rank
+    assert Outcome(math.inf, True).rank > swerve_out.rank
+    assert Outcome(0.8, False).rank > swerve_out.rank
+    # Both hit by a likely future: at rest when hit still comes first (passive safety).
+    assert Outcome(0.5, True, 1.0).rank > Outcome(0.5, False, 2.0).rank
+
+
+@pytest.mark.parametrize("name, rate, timing, seed", [
+    ("crowd_crossing", 10, "constant", 6),  # braked to rest in a walker's way
+    ("crowd_merge", 10, "optimal", 3),  # a goal in the stream: evaded it, never came back
+])
+def test_runs_that_failed_before(name, rate, timing, seed):
+    run = simulate(planner.load_scenario(name),
+                   SimSettings(rate=rate, timing=timing, seed=seed, fixed_latency_ms=20))
+    s = run.summary
+    assert s["collisions"] == 0 and s["reached_goal"], s
+

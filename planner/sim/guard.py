@@ -56,16 +56,24 @@ class Manoeuvre:
 
 
 class Outcome(NamedTuple):
-    """How a rollout fares: clear for ``clear_s`` (inf: the whole horizon), and whether the car
-    stands still where it may first be hit (passive safety: then the contact is not its own)."""
+    """How a rollout fares: clear of the grown predictions for ``clear_s`` (inf: the whole
+    horizon), clear of the likely futures (constant velocity, not grown) for ``likely_s``, and
+    whether the car stands still where it may first be hit — by a likely future where one hits
+    it — (passive safety: then the contact is not its own)."""
 
     clear_s: float
     at_rest: bool
+    likely_s: float = math.inf
 
     @property
     def rank(self):
-        """Clear throughout first, then at rest when hit, then clear for longest."""
-        return (self.clear_s == math.inf, self.at_rest, self.clear_s)
+        """Clear of the grown predictions throughout first, then clear of the likely futures
+        throughout, then at rest when hit, then clear for longest.
+
+        Standing still is no refuge from a mover that walks straight at the car: a swerve that
+        leaves its likely path beats a stop in it."""
+        return (self.clear_s == math.inf, self.likely_s == math.inf, self.at_rest,
+                self.likely_s, self.clear_s)
 
 
 @dataclass(frozen=True)
@@ -87,11 +95,16 @@ class _Rollouts:
     """Rollouts from one state against one believed world (planner time 0 = the decision)."""
 
     def __init__(self, world: World, margin: float, state, limits: Limits,
-                 ref: Reference | None, i: int, stop_s: float, rho: float) -> None:
+                 ref: Reference | None, i: int, stop_s: float, rho: float,
+                 done_s: float = math.inf) -> None:
         self.world, self.margin, self.limits, self.ref, self.stop_s = (world, margin, limits,
                                                                       ref, stop_s)
+        likely = world.m_grow.copy()
+        likely[:, 1:3] = 0.0  # no growth: each mover where its sensed velocity takes it
+        self.likely = world._replace(m_grow=likely)
         self.x, self.y, self.th, self.v, self.steer = state
         self.s0 = float(ref.s[i]) if ref is not None else 0.0
+        self.done_s = done_s if self.s0 < done_s else math.inf  # missed it: check on
         self.n = int(round(HORIZON / STEP)) + 1
         self.t = np.arange(self.n) * STEP
         # How fast the believed movers close in, per sample: their speed, plus their
@@ -121,7 +134,8 @@ class _Rollouts:
         poses = np.empty((self.n, 3))
         poses[:, :2] = ref.rows[j, :2] + u[:, None] * (ref.rows[j + 1, :2] - ref.rows[j, :2])
         poses[:, 2] = np.where(u < 0.5, ref.rows[j, 2], ref.rows[j + 1, 2])
-        return self._clear(poses, vs)
+        end = int(np.searchsorted(ss, self.done_s)) + 1  # the run ends in the goal
+        return self._clear(poses[:end], vs[:end])
 
     def free(self, m: Manoeuvre) -> Outcome:
         """Clear time of an open-loop manoeuvre: steering towards ``m.steer`` at the rate
@@ -148,19 +162,26 @@ class _Rollouts:
 
     def _clear(self, poses: np.ndarray, vs: np.ndarray) -> Outcome:
         """The time of the first sample pair that may hide a contact (inf: none): with the
-        movers as believed (grown, with the margin), with the static world as it is."""
-        samples = np.zeros((self.n, 6))
+        movers as believed (grown, with the margin), with the static world as it is; if there
+        is one, also with the movers' likely futures."""
+        n = len(poses)
+        samples = np.zeros((n, 6))
         samples[:, :3] = poses
-        samples[:, 5] = self.t
-        moving = path_moving_clearances(self.world, samples)
-        samples[:, 5] = math.nan  # static obstacles only
-        static = path_clearances(self.world, samples, True) + self.margin
         drive = np.abs(vs[:-1]) * self.reach * STEP
-        bad = np.flatnonzero(_unsure(moving, drive + self.closing) | _unsure(static, drive))
+        samples[:, 5] = math.nan  # static obstacles only
+        static = _unsure(path_clearances(self.world, samples, True) + self.margin, drive)
+        samples[:, 5] = self.t[:n]
+        closing = drive + self.closing[:n - 1]
+        bad = np.flatnonzero(_unsure(path_moving_clearances(self.world, samples), closing)
+                             | static)
         if len(bad) == 0:
             return Outcome(math.inf, True)
         k = bad[0]
-        return Outcome(float(self.t[k]), max(abs(vs[k]), abs(vs[k + 1])) < 1e-9)
+        likely = np.flatnonzero(_unsure(path_moving_clearances(self.likely, samples), closing)
+                                | static)
+        j = likely[0] if len(likely) else k
+        return Outcome(float(self.t[k]), max(abs(vs[j]), abs(vs[j + 1])) < 1e-9,
+                       float(self.t[likely[0]]) if len(likely) else math.inf)
 
 
 def _unsure(c: np.ndarray, drop: np.ndarray) -> np.ndarray:
@@ -174,7 +195,7 @@ def _toward(v: float, want: float, step: float) -> float:
 
 def guard(world: World, margin: float, state, limits: Limits, ref: Reference | None, i: int,
           stop_s: float, cruise: float, commit: float, rho: float, reverse: bool,
-          stuck: bool = False) -> Decision:
+          stuck: bool = False, done_s: float = math.inf) -> Decision:
     """The car's manoeuvre until the next decision, ``commit`` s from now.
 
     ``state``: (x, y, θ, v, δ) now; ``ref``/``i``: the plan and the car's row on it (None: no
@@ -182,9 +203,11 @@ def guard(world: World, margin: float, state, limits: Limits, ref: Reference | N
     plan's end); ``world``: the grown prediction with planner time 0 now, inflated by
     ``margin`` (which the static check gives back: the car may come as near a wall as it is);
     ``stuck``: the car has stood, not by plan, for a while — a forward-only planner finds no
-    way round an obstacle right in front, so it backs off a little if that is clear.
+    way round an obstacle right in front, so it backs off a little if that is clear;
+    ``done_s``: the arc where the plan enters the goal and the run ends (inf: none) — a goal in
+    a stream of traffic is reached, not stood in, so the check along the plan ends there.
     """
-    r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho)
+    r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho, done_s)
     tried: list[tuple[Outcome, Manoeuvre]] = []
     if stuck and reverse:  # a forward-only plan finds no way on: make room behind
         m = Manoeuvre(BACK_OFF, -0.5 * cruise, steer=0.0)

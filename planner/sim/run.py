@@ -135,15 +135,26 @@ class Frame:
     guard: str = "follow"  # what the guard has the car do: a key of `GUARD_CODES`
 
 
-def _in_goal(problem: Problem, x: float, y: float, th: float) -> bool:
+def _in_goal(problem: Problem, x, y, th, share: float = 1.0):
+    """Whether the pose (scalars or arrays) is in the goal region shrunk to ``share`` of its
+    tolerances."""
     gx, gy, gth = problem.goal
-    return (math.hypot(x - gx, y - gy) <= problem.goal_position_tol
-            and abs(math.remainder(th - gth, 2.0 * math.pi)) <= problem.goal_heading_tol)
+    return ((np.hypot(x - gx, y - gy) <= share * problem.goal_position_tol)
+            & (np.abs(np.remainder(th - gth + math.pi, 2.0 * math.pi) - math.pi)
+               <= share * problem.goal_heading_tol))
+
+
+def _goal_arc(problem: Problem, ref: Reference) -> float:
+    """The arc where ``ref`` is well inside the goal (half its tolerances: the car tracks it
+    to a few cm), so the run ends there; inf if it does not get there."""
+    k = np.flatnonzero(_in_goal(problem, *ref.rows[:, :3].T, share=0.5))
+    return float(ref.s[k[0]]) if len(k) else math.inf
 
 
 # The guard keeps this share of the planning margin for tracking errors: the plans, made with
 # all of it, pass its check with room to spare.
 GUARD_MARGIN = 0.5
+OFF_PLAN = 0.3  # m from the plan beyond which the car no longer counts as on it
 STUCK_S = 2.0  # s at rest, not by plan, before the car backs off once (`guard.BACK_OFF`)
 # Per-tick guard codes in the log's ``guard`` column.
 GUARD_CODES = {"follow": 0, "wait": 1, "slow": 2, "brake": 3, "evade": 4, "back-off": 5}
@@ -164,15 +175,17 @@ def _state(decision: Decision | None, waiting: bool) -> str:
 def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertainty,
             s: SimSettings,
             limits: Limits, state, ref: Reference | None, stop_s: float, cruise: float,
-            commit: float, stuck: bool) -> Decision:
+            commit: float, stuck: bool, done_s: float) -> Decision:
     """The guard's decision at a cycle's start, in the world the car believes in now (grown
     predictions, the planning margin; the bare car where it already is inside the margin)."""
     believed = predicted_world(problem.world, sensing, t, uncertainty)
     margin = GUARD_MARGIN * s.margin
     margin = margin if clearance(believed, state[0], state[1], 0.0) > margin else 0.0
     i = ref.project(state[0], state[1])[0] if ref is not None else 0
+    if ref is not None and math.dist(state[:2], ref.rows[i, :2]) > OFF_PLAN:
+        ref = None  # the car is not where the plan is: checks along it would be fiction
     return guard(inflated(believed, margin), margin, state, limits, ref, i, stop_s, cruise,
-                 commit, problem.rho, s.reverse, stuck)
+                 commit, problem.rho, s.reverse, stuck, done_s)
 
 
 def _lap_counter(scenario: Scenario, problem: Problem, s: SimSettings, load_track):
@@ -230,7 +243,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     v = steer = 0.0
     e_old = math.nan
     sensing, j_sense = None, 0
-    ref, stop_s, conflict = None, 0.0, False
+    ref, stop_s, conflict, done_s = None, 0.0, False, math.inf
     pending, next_cycle = None, 0.0 if fsm is None or fsm.planning else math.inf
     walls, cycles, replans, stops, waits, was_stopped = [], [], 0, 0, 0, False
     planned = False  # the current stop is a planned wait (timing optimal), not an emergency
@@ -256,6 +269,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
             cyc = pending[1]
             if cyc.reference is not None:
                 ref = cyc.reference
+                done_s = _goal_arc(problem, ref) if counter is None and fsm is None else math.inf
             stop_s, conflict = cyc.stop_s, cyc.conflict and s.replan
             planned = cyc.planned_wait
             replans += cyc.replaced
@@ -277,7 +291,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                 decision = _decide(problem, sensing, t, uncertainty, s, limits, (*est, v, steer),
                                    ref, stop_s, cruise, lead,
                                    backing or (not backed_off
-                                               and t - planless_since >= STUCK_S))
+                                               and t - planless_since >= STUCK_S), done_s)
                 decided_at = t
                 if decision.manoeuvre.name == BACK_OFF and not backing:
                     backed_at, backed_off = t, True  # once, until the car drives on again
