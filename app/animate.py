@@ -141,7 +141,7 @@ def _draw_world(ax, problem) -> None:
     from matplotlib.collections import LineCollection
     from matplotlib.patches import Circle
 
-    from planner._world import offset
+    from planner.sim.sensing import true_offsets
 
     w = problem.world
     xmin, ymin, xmax, ymax = problem.bounds
@@ -153,7 +153,7 @@ def _draw_world(ax, problem) -> None:
     ax.plot([xmin, xmax, xmax, xmin, xmin], [ymin, ymin, ymax, ymax, ymin], color=WORLD)
 
     def at_start(m: int) -> np.ndarray:
-        return np.array(offset(w, m, 0.0)) if m >= 0 else np.zeros(2)
+        return true_offsets(w, np.array([m]), 0.0)[0, 0]
 
     segments = [e.reshape(2, 2) for e in w.ring_edges]
     for p, m in enumerate(w.poly_motion):
