@@ -6,7 +6,8 @@ Reeds-Shepp) state space with our turning radius, poses checked every 0.02 m alo
 goal region with position and heading tolerances whose one goal sample is the exact goal pose,
 path length as the objective with a cost threshold of 0 (the optimising planners use the whole
 budget). Pose validity is a callable ``is_free(x, y, theta)``; for a study it is our own world's
-clearance, so ours and OMPL plan on exactly the same free space.
+clearance, so ours and OMPL plan on the same free space (ours also keeps the sag of its rows'
+chords, a third of a millimetre: docs/planner.md "Valid as written").
 
 OMPL's random seed is process-wide and takes effect only before the first random number is
 drawn, so every seeded run needs a fresh process: `plan_isolated` starts one

@@ -27,7 +27,8 @@ class PlanReport(BaseModel):
     iterations: int
     nodes: int
     collision_checks: int = Field(description="motion checks (each exact, over a whole edge)")
-    min_clearance_m: float | None = Field(description="over the path, every 5 mm, in space-time")
+    min_clearance_m: float | None = Field(
+        description="of the returned rows joined by straight chords, every 5 mm, in space-time")
     max_abs_curvature: float | None
     arrival_time_s: float | None = Field(None, description="with moving obstacles or timing "
                                                             "optimal")

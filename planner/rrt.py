@@ -18,16 +18,16 @@ from planner import _kernel as K
 from planner._paths import TURN, advance, pose_at, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
+from planner._rows import SPACING_M, chord_sag, polyline_clearance
 from planner._steer import steer_path
-from planner._world import inflated, path_clearances
+from planner._world import World, inflated
 from planner.options import METRICS, PlanOptions
 from planner.problem import Problem, check_room
 from planner.steering import STEERINGS
 from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points, path_points
 
-__all__ = ["Planner", "Result", "warm_up"]
+__all__ = ["Planner", "Result", "checked_world", "warm_up"]
 
-CLEARANCE_SPACING_M = 0.005  # as FORMAT.md re-checks returned paths
 POLISHED_PER_BATCH = 4096  # nodes a batch's events can name as added by polishing
 
 @dataclass
@@ -87,8 +87,8 @@ class Planner:
         s = self.options
         if s.safety_margin > problem.margin:
             check_room(problem, s.safety_margin)
-        # The world as this planner checks it: the footprint grown by the safety margin.
-        self._world = inflated(problem.world, s.safety_margin)
+        self._world = checked_world(problem.world, problem.rho, s)
+        steering = STEERINGS[s.steering]
         xmin, ymin, xmax, ymax = problem.bounds
         diag = math.hypot(xmax - xmin, ymax - ymin)
         cell = min(max(s.eps / 10.0, diag / 400.0), diag / 8.0)
@@ -96,7 +96,6 @@ class Planner:
         grid = np.array([xmin, ymin, cell, nx, ny], dtype=float)
         self._tree = K.new_tree(capacity, grid, seed_state(s.seed))
         self._tree.cnt[K.BEST] = -1
-        steering = STEERINGS[s.steering]
         P = np.zeros(K.NPARAMS)
         P[K.EPS], P[K.GAMMA], P[K.GOAL_BIAS] = s.eps, s.gamma, s.goal_bias
         P[K.RHO], P[K.SPEED] = problem.rho, s.speed
@@ -282,7 +281,7 @@ class Planner:
             node = int(self._tree.parent[node])
         return chain[::-1]
 
-    def dense_path(self, spacing: float = 0.05) -> np.ndarray:
+    def dense_path(self, spacing: float = SPACING_M) -> np.ndarray:
         """The best path sampled every ≤ spacing m: columns x, y, θ, κ, direction, t."""
         t = self._tree
         chain = self.best_path_nodes()
@@ -364,16 +363,15 @@ class Planner:
         return int(copied)
 
     def best_path_clearance(self) -> float | None:
-        """The least clearance along the best path, in space-time: the one definition of the
-        path metric (checked every 5 mm; None before a solution)."""
+        """The least clearance of the best path as returned, its rows joined by chords, in
+        space-time: the one definition of the path metric (None before a solution)."""
         if not self.solved:
             return None
-        fine = self.dense_path(CLEARANCE_SPACING_M)
-        return float(path_clearances(self.problem.world, fine, self.problem.timed).min())
+        return polyline_clearance(self.problem.world, self.dense_path(), self.problem.timed)
 
     def result(self) -> Result:
         t = self._tree
-        path = self.dense_path(0.05)
+        path = self.dense_path()
         solved = self.solved
         min_clear = self.best_path_clearance()
         return Result(
@@ -414,6 +412,14 @@ def _step_lengths(pts: np.ndarray) -> np.ndarray:
     kappa = np.abs(pts[1:, 3])
     arc = np.where(kappa > 0, dth / np.where(kappa > 0, kappa, 1.0), chord)
     return np.maximum(arc, chord)
+
+
+def checked_world(world: World, rho: float, options: PlanOptions) -> World:
+    """The world as a planner with (resolved) ``options`` checks it: the footprint grown by the
+    safety margin and, for a steering that drives arcs, by the sag of the returned rows' chords
+    (`planner._rows`), so that a path is valid as written."""
+    curved = STEERINGS[options.steering].curved
+    return inflated(world, options.safety_margin + (chord_sag(rho) if curved else 0.0))
 
 
 _warm = False

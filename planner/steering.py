@@ -24,6 +24,8 @@ class Steering:
     ``heading_free``: a point or disc robot that turns on the spot — the goal is reached by
     position, a rectangular footprint (whose sweep a turn on the spot would ignore) is refused,
     and RRT*'s near radius shrinks as in the plane (d = 2) instead of in (x, y, θ) (d = 3).
+    ``curved``: it drives arcs of curvature up to 1/ρ, so the chords between a path's rows stray
+    from it (`planner._rows.chord_sag`).
     """
 
     name: str
@@ -32,6 +34,7 @@ class Steering:
     reverses: bool
     heading_free: bool
     summary: str
+    curved: bool = True
 
 
 STEERINGS = {s.name: s for s in (
@@ -40,7 +43,7 @@ STEERINGS = {s.name: s for s in (
              "forward and reverse (Reeds & Shepp 1990)"),
     Steering("straight", "Straight line", STRAIGHT, False, True,
              "straight lines for a point or disc robot that turns on the spot, goal by "
-             "position (the classic RRT picture, LaValle 1998)"),
+             "position (the classic RRT picture, LaValle 1998)", curved=False),
 )}
 
 SteeringName = Literal[tuple(STEERINGS)]  # the names, for pydantic and typer

@@ -25,21 +25,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planner._rows import SPACING_M, polyline_clearance
 from planner._schedule import earliest_arrival, no_wait_needed, pose_on
-from planner._world import inflated, path_clearances, without_movers
+from planner._world import without_movers
 from planner.options import TIMINGS, PlanOptions
 from planner.problem import Problem
-from planner.rrt import Planner, Result
+from planner.rrt import Planner, Result, checked_world
 from planner.scenario import ScenarioError
 
 __all__ = ["TIMINGS", "Schedule", "TimeOptimalPlanner", "fastest_schedule", "planner_for",
            "warm_up"]
 
-MAX_SPACING_M, MAX_STEP_S = 0.05, 0.1  # FORMAT.md v1.3: entries at most this far apart
+MAX_STEP_S = 0.1  # docs/scenario-format.md v1.3: entries at most `SPACING_M` and this apart
 EXTRA_WAIT_S = 60.0  # how long past the top-speed arrival a schedule may wait, at least
 MAX_WAIT_S = 600.0  # … and at most, whatever the waypoints' times
 MAX_CELLS = 4_000_000  # s–t grid points; a longer path or horizon gets coarser stations
-FINE_SPACING_M, FINE_STEP_S = 0.005, 0.01  # the clearance metric's sampling
 MAX_ROWS = 200_000  # path entries of a timed path (FORMAT.md spacing): about 10 MB of JSON
 PROBE_SHARE = 0.2  # of a time budget, for each tree before the leader takes the rest
 
@@ -63,16 +63,16 @@ class Schedule:
     @property
     def spacing_m(self) -> float:
         """FORMAT.md v1.3's: entries at most 0.05 m apart, and 0.1 s at vmax."""
-        return min(MAX_SPACING_M, MAX_STEP_S * self.vmax)
+        return min(SPACING_M, MAX_STEP_S * self.vmax)
 
     @property
     def arrival_s(self) -> float:
         return self.length_m / self.vmax + self.waited_s
 
-    def rows(self, spacing: float | None = None, wait_step: float = MAX_STEP_S) -> np.ndarray:
-        """The path as rows x, y, θ, κ, direction, t (FORMAT.md v1.3): at most ``spacing`` m
-        (default: FORMAT.md's, `spacing_m`) and ``wait_step`` s apart."""
-        dense = self.planner.dense_path(spacing or self.spacing_m)
+    def rows(self) -> np.ndarray:
+        """The path as rows x, y, θ, κ, direction, t (docs/scenario-format.md v1.3): at most
+        `spacing_m` m and `MAX_STEP_S` s apart."""
+        dense = self.planner.dense_path(self.spacing_m)
         s_rows = dense[:, 5] * self.planner.options.speed  # driven length
         if self.waits is None:
             return _with_times(dense, s_rows / self.vmax)
@@ -86,7 +86,7 @@ class Schedule:
             x, y, th = pose_on(*self.planner.best_path_segments(), self.planner.problem.rho,
                                k * ds)
             j = min(int(np.searchsorted(s_rows, k * ds)), len(dense) - 1)
-            instants = np.linspace(arrive[k], leave[k], math.ceil(waits[k] * dt / wait_step) + 1)
+            instants = np.linspace(arrive[k], leave[k], math.ceil(waits[k] * dt / MAX_STEP_S) + 1)
             wait = np.tile([x, y, th, dense[j, 3], dense[j, 4], 0.0], (len(instants), 1))
             wait[:, 5] = instants
             rows.append(wait)
@@ -112,7 +112,7 @@ def fastest_schedule(planner: Planner, world, vmax: float,
         last_wp = float(world.m_wp[:, 0].max()) if world.m_wp.shape[0] else 0.0
         wait_s = min(max(EXTRA_WAIT_S, last_wp), MAX_WAIT_S)
     horizon = length / vmax + wait_s
-    ds = max(min(MAX_SPACING_M, MAX_STEP_S * vmax),
+    ds = max(min(SPACING_M, MAX_STEP_S * vmax),
              math.sqrt(length * horizon * vmax / MAX_CELLS))
     n = max(1, math.ceil(length / ds))
     ds = length / n
@@ -141,8 +141,7 @@ class TimeOptimalPlanner:
         static = dataclasses.replace(problem, world=without_movers(problem.world), timed=False)
         self.route = Planner(static, options)
         self.detour = Planner(problem, options) if problem.timed else None
-        # The movers as the planners check them: the footprint grown by the safety margin.
-        self._movers = inflated(problem.world, self.route.options.safety_margin)
+        self._movers = checked_world(problem.world, problem.rho, self.route.options)
 
     @property
     def planners(self) -> list[Planner]:
@@ -218,11 +217,11 @@ class TimeOptimalPlanner:
                 f"vehicle.max_speed: {best.vmax:g} m/s over {best.length_m:.1f} m needs about "
                 f"{entries:.3g} path entries at most 0.05 m and 0.1 s apart, more than "
                 f"{MAX_ROWS}: give a higher max_speed, or plan with timing constant")
-        path, fine = best.rows(), best.rows(FINE_SPACING_M, FINE_STEP_S)
+        path = best.rows()
         return dataclasses.replace(
             results[self.planners.index(best.planner)], **totals, cost=float(path[-1, 5]),
             path=path, timed=True, time_to_first_solution_s=first,
-            min_clearance_m=float(path_clearances(self.problem.world, fine, True).min()),
+            min_clearance_m=polyline_clearance(self.problem.world, path, True),
             cost_over_time=[(totals["planning_time_s"], best.arrival_s, totals["iterations"])],
             objective="time", length_m=best.length_m, waited_s=best.waited_s,
             options=self.options)

@@ -1,8 +1,9 @@
 """An independent validity checker for planned paths, written from FORMAT.md alone.
 
-Plain numpy, no planner code: it reconstructs the arc between consecutive path points from the
-two poses, densifies to 5 mm and tests every pose against the scenario's obstacles where they
-are at that instant. The car is FORMAT.md's disc of ``vehicle.radius`` or, in the rich schema
+Plain numpy, no planner code: it joins consecutive path points by the arc the two poses define
+(or by the straight chord, as a consumer of the rows does), densifies, and tests every pose
+against the scenario's obstacles where they are at that instant, and against a track's drivable
+region when the scene gives its rings (``region``, even-odd). The car is FORMAT.md's disc of ``vehicle.radius`` or, in the rich schema
 (docs/planner.md), the rectangle ``vehicle.footprint`` at its exact outline (not the discs the
 planner covers it with): the pose is the rear axle, the rectangle runs ``rear_overhang`` behind
 it and ``length - rear_overhang`` ahead along the heading, ``width / 2`` to either side.
@@ -34,15 +35,6 @@ def _inside_even_odd(pts: np.ndarray, x: float, y: float) -> bool:
         if (y1 > y) != (y2 > y) and x < x1 + (y - y1) * (x2 - x1) / (y2 - y1):
             inside = not inside
     return inside
-
-
-def _edge_distance(pts: np.ndarray, x: float, y: float) -> float:
-    a = pts
-    b = np.roll(pts, -1, axis=0)
-    ab = b - a
-    u = np.clip(((x - a[:, 0]) * ab[:, 0] + (y - a[:, 1]) * ab[:, 1])
-                / np.maximum((ab ** 2).sum(axis=1), 1e-300), 0, 1)
-    return float(np.hypot(a[:, 0] + u * ab[:, 0] - x, a[:, 1] + u * ab[:, 1] - y).min())
 
 
 def _outline(ob: dict) -> np.ndarray:
@@ -155,26 +147,87 @@ def pose_valid(scn: dict, x: float, y: float, t: float | None,
                theta: float | None = None) -> bool:
     """FORMAT.md validity at time t (None: static obstacles only). A rectangle footprint
     (rich schema) needs the heading ``theta``; a disc car ignores it."""
+    if theta is None and footprint(scn.get("vehicle", {})) is not None:
+        raise ValueError("a rectangle footprint is checked at a heading: give theta")
+    pose = np.array([[x, y, 0.0 if theta is None else theta]])
+    return bool(poses_valid(scn, pose, None if t is None else np.array([t]))[0])
+
+
+def poses_valid(scn: dict, poses: np.ndarray, times: np.ndarray | None) -> np.ndarray:
+    """`pose_valid` for many poses (x, y, theta rows) at once, at ``times`` (None: static
+    obstacles only). A rectangle is tested exactly only where its circumscribed disc is not
+    clear: where that disc is, the rectangle inside it is too."""
     vehicle = scn.get("vehicle", {})
     rect = footprint(vehicle)
-    if rect is not None:
-        if theta is None:
-            raise ValueError("a rectangle footprint is checked at a heading: give theta")
-        return _rectangle_valid(scn, rect, x, y, theta, t)
-    r = vehicle.get("radius", 0.0)
+    if rect is None:
+        return _discs_valid(scn, poses, times, vehicle.get("radius", 0.0))
+    length, width, overhang = rect
+    reach = math.hypot(max(overhang, length - overhang), width / 2)
+    valid = _discs_valid(scn, poses, times, reach)
+    for k in np.flatnonzero(~valid):
+        valid[k] = _rectangle_valid(scn, rect, *poses[k], None if times is None else times[k])
+    return valid
+
+
+def _discs_valid(scn: dict, poses: np.ndarray, times: np.ndarray | None,
+                 r: float) -> np.ndarray:
+    """FORMAT.md's test of a disc car of radius r, per pose."""
+    x, y = poses[:, 0], poses[:, 1]
     xmin, ymin, xmax, ymax = scn["bounds"]
-    if not (xmin + r <= x <= xmax - r and ymin + r <= y <= ymax - r):
-        return False
-    for ob, dx, dy in _obstacles_at(scn, t):
+    valid = (xmin + r <= x) & (x <= xmax - r) & (ymin + r <= y) & (y <= ymax - r)
+    for ob in scn["obstacles"]:
+        if times is None and ob.get("motion"):
+            continue
+        dx, dy = _offsets(ob, times)
         if ob["type"] == "circle":
             cx, cy = ob["center"]
-            if math.hypot(x - cx - dx, y - cy - dy) <= ob["radius"] + r:
-                return False
-        else:
-            pts = _outline(ob) + [dx, dy]
-            if _inside_even_odd(pts, x, y) or (r > 0 and _edge_distance(pts, x, y) <= r):
-                return False
-    return True
+            valid &= np.hypot(x - cx - dx, y - cy - dy) > ob["radius"] + r
+            continue
+        px, py = x - dx, y - dy  # the obstacle at rest, the car moved by the opposite offset
+        edges = _closed(_outline(ob))
+        valid &= ~_inside(edges, px, py)
+        if r > 0:
+            valid &= _edges_distance(edges, px, py) > r
+    region = scn.get("region")  # a track's drivable region: rings, even-odd
+    if region:
+        edges = np.vstack([_closed(np.asarray(ring, dtype=float)) for ring in region])
+        valid &= _inside(edges, x, y) & (_edges_distance(edges, x, y) > r)
+    return valid
+
+
+def _closed(pts: np.ndarray) -> np.ndarray:
+    """A polygon's edges (x1, y1, x2, y2), the last point joined to the first."""
+    return np.hstack([pts, np.roll(pts, -1, axis=0)])
+
+
+def _inside(edges: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+    """Even-odd rule: whether each point is inside the edges' polygon(s)."""
+    inside = np.zeros(len(px), bool)
+    for x1, y1, x2, y2 in edges:
+        crosses = (y1 > py) != (y2 > py)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inside ^= crosses & (px < x1 + (py - y1) * (x2 - x1) / (y2 - y1))
+    return inside
+
+
+def _edges_distance(edges: np.ndarray, px: np.ndarray, py: np.ndarray,
+                    chunk: int = 4096) -> np.ndarray:
+    """Each point's distance to the nearest edge (in chunks of points: bounded memory)."""
+    return np.concatenate([
+        _point_segment(px[i:i + chunk, None], py[i:i + chunk, None], edges[None]).min(axis=1)
+        for i in range(0, len(px), chunk)]) if len(px) else np.zeros(0)
+
+
+def _offsets(ob: dict, times: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """The obstacle's offsets at ``times`` (zero for a static one or without times)."""
+    motion = ob.get("motion")
+    if not motion or times is None:
+        return np.zeros(1), np.zeros(1)
+    if "velocity" in motion:
+        vx, vy = motion["velocity"]
+        return vx * times, vy * times
+    wp = np.asarray(motion["waypoints"], dtype=float)
+    return np.interp(times, wp[:, 0], wp[:, 1]), np.interp(times, wp[:, 0], wp[:, 2])
 
 
 def densify(path: np.ndarray, step: float = 0.005, time_step: float = 0.005) -> np.ndarray:
@@ -206,15 +259,35 @@ def densify(path: np.ndarray, step: float = 0.005, time_step: float = 0.005) -> 
     return np.vstack(out)
 
 
-def first_collision(scn: dict, path, step: float = 0.005) -> float | None:
-    """Arc length of the first invalid pose on the path (timed if it has a t column), or None."""
-    dense = densify(np.asarray(path, dtype=float), step)
+def chords(path: np.ndarray, step: float = 0.001, time_step: float = 0.001) -> np.ndarray:
+    """Rows x, y, theta[, t] every ≤ step and ≤ time_step along the straight chords between
+    the path's rows, as a consumer joins them: every column linear, the heading the short way
+    round (a turn on the spot, where both positions are the same, by angle steps of ``step``
+    rad)."""
+    path = np.asarray(path, dtype=float)
+    out = [path[:1]]
+    for p, q in zip(path[:-1], path[1:]):
+        dth = (q[2] - p[2] + math.pi) % (2 * math.pi) - math.pi
+        n = max(1, math.ceil(math.hypot(q[0] - p[0], q[1] - p[1]) / step),
+                math.ceil(abs(dth) / step))
+        if path.shape[1] > 3:
+            n = max(n, math.ceil((q[3] - p[3]) / time_step))
+        f = (np.arange(1, n + 1) / n)[:, None]
+        gap = q - p
+        gap[2] = dth
+        out.append(p + f * gap)
+    return np.vstack(out)
+
+
+def first_collision(scn: dict, path, step: float = 0.005, along: str = "arcs") -> float | None:
+    """Arc length of the first invalid pose on the path (timed if it has a t column), or None;
+    the path's rows joined by the car's arcs (``along="arcs"``) or by straight chords
+    (``"chords"``)."""
+    path = np.asarray(path, dtype=float)
+    dense = densify(path, step) if along == "arcs" else chords(path, step)
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(dense[:, :2], axis=0).T))])
-    timed = dense.shape[1] > 3
-    for k, row in enumerate(dense):
-        if not pose_valid(scn, row[0], row[1], row[3] if timed else None, row[2]):
-            return float(s[k])
-    return None
+    valid = poses_valid(scn, dense[:, :3], dense[:, 3] if dense.shape[1] > 3 else None)
+    return None if valid.all() else float(s[np.argmin(valid)])
 
 
 def arc_mismatch(path) -> float:

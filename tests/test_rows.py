@@ -1,0 +1,102 @@
+"""Every returned path is valid as written: its rows joined by straight chords, as a consumer
+joins them, re-checked every 1 mm by the independent checker (tests/checker.py)."""
+
+import math
+
+import numpy as np
+import pytest
+from checker import first_collision
+from conftest import scenario_dict
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import planner
+from planner._rows import chord_sag, polyline, polyline_clearance
+from planner.problem import follow_waypoints, resolve_track
+from planner.scenario import ScenarioError
+
+BUNDLED = [p.stem for p in sorted(planner.bundled_scenario_path("slalom").parent.glob("*.json"))]
+
+
+def checker_scene(name: str) -> dict:
+    """The scenario as the checker reads it: a track scene gets its drivable region's rings
+    (from the tracks layer), bounds around them, and its track-following movers as waypoints."""
+    scn = scenario_dict(name)
+    if "track" not in scn:
+        return scn
+    parsed = planner.parse_scenario(scn)
+    track = resolve_track(parsed)
+    rings = track.region_rings()
+    pts = np.vstack(rings)
+    obstacles = []
+    for ob, model in zip(scn["obstacles"], parsed.obstacles):
+        follow = model.motion.follow_track if model.motion is not None else None
+        if follow is not None:
+            ob = {**ob, "motion": {"waypoints": follow_waypoints(track, follow).tolist()}}
+        obstacles.append(ob)
+    return {**scn, "obstacles": obstacles, "region": [r.tolist() for r in rings],
+            "bounds": [*(pts.min(axis=0) - 1.0), *(pts.max(axis=0) + 1.0)]}
+
+
+def chords_valid(scn: dict, result) -> None:
+    """The rows, with their times where the scene moves, pass the chord check at 1 mm."""
+    path = result.path[:, [0, 1, 2, 5]] if result.timed else result.path[:, :3]
+    assert first_collision(scn, path, step=0.001, along="chords") is None
+    assert result.min_clearance_m > 0
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_every_planner_steering_and_timing_returns_rows_valid_along_their_chords(name):
+    scn = scenario_dict(name)
+    seen = checker_scene(name)
+    solved = 0
+    for algorithm in ("rrt", "rrtstar"):
+        for steering in planner.STEERINGS:
+            for timing in ("constant", "optimal"):
+                try:
+                    result = planner.solve(planner.parse_scenario(scn), time_limit=None,
+                                           iterations=2500, planner=algorithm,
+                                           steering=steering, timing=timing, seed=1)
+                except ScenarioError as e:  # the one refusal: a turn on the spot and a box
+                    assert "footprint" in str(e) and steering == "straight", e
+                    continue
+                if result.solved:
+                    solved += 1
+                    chords_valid(seen, result)
+    assert solved >= 4, f"{name}: only {solved} of 12 runs solved, too few to check"
+
+
+@settings(max_examples=12, deadline=None)
+@given(discs=st.lists(st.tuples(st.floats(1.5, 8.5), st.floats(1.5, 8.5), st.floats(0.2, 1.0)),
+                      min_size=1, max_size=8),
+       steering=st.sampled_from(list(planner.STEERINGS)), seed=st.integers(0, 5))
+def test_random_scenes_return_rows_valid_along_their_chords(discs, steering, seed):
+    scn = {"name": "random", "bounds": [0, 0, 10, 10], "start": [0.5, 0.5, 0.0],
+           "goal": [9.5, 9.5, 0.0], "goal_tolerance": {"position": 0.3, "heading_deg": 30},
+           "vehicle": {"radius": 0.2, "wheelbase": 0.44, "max_steer_deg": 35},
+           "obstacles": [{"type": "circle", "center": [x, y], "radius": r} for x, y, r in discs
+                         if math.hypot(x - 0.5, y - 0.5) > r + 0.3
+                         and math.hypot(x - 9.5, y - 9.5) > r + 0.3]}
+    result = planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=800,
+                           steering=steering, seed=seed)
+    if result.solved:
+        chords_valid(scn, result)
+
+
+def test_polyline_clearance_is_the_clearance_of_the_chords_not_of_the_arc():
+    """Rows every 5 cm on a circle of radius 2 about a disc: the chords' midpoints come nearer
+    to it by the sagitta, and so does the reported clearance."""
+    scn = {"name": "ring", "bounds": [-5, -5, 5, 5], "start": [2.0, 0.0, math.pi / 2],
+           "goal": [-2.0, 0.0, -math.pi / 2], "vehicle": {"radius": 0.1},
+           "obstacles": [{"type": "circle", "center": [0, 0], "radius": 1.5}]}
+    problem = planner.compile_problem(planner.parse_scenario(scn))
+    step = 0.05 / 2.0  # rad: 5 cm of arc
+    th = np.arange(0.0, math.pi + 1e-9, step)
+    rows = np.column_stack([2 * np.cos(th), 2 * np.sin(th), th + math.pi / 2,
+                            np.full_like(th, 0.5), np.ones_like(th), th])
+    sag = 2.0 * (1.0 - math.cos(step / 2))
+    assert sag <= chord_sag(2.0) < 1.001 * sag
+    assert polyline_clearance(problem.world, rows, False) == pytest.approx(0.4 - sag, abs=1e-9)
+    fine = polyline(rows, step=0.005)
+    assert np.hypot(*np.diff(fine[:, :2], axis=0).T).max() <= 0.005 + 1e-12
+    assert fine[-1].tolist() == rows[-1].tolist()
