@@ -1,9 +1,10 @@
 """OMPL baseline for the planner benchmark: one (scenario, planner, time limit, seed) run.
 
-The problem is set up by `planner.ompl_bridge` the way the shared scenarios' FORMAT.md defines it
+The problem is set up by `planner.ompl_bridge` the way docs/scenario-format.md defines it
 (Dubins steering, motions checked every 0.02 m, a goal region with position and heading
 tolerances, path length as the objective); pose validity here is a pure-Python checker with
-FORMAT.md's exact semantics, so that this baseline does not depend on our compiled world.
+docs/scenario-format.md's exact semantics, so that this baseline does not depend on our
+compiled world.
 
 OMPL's random seed is process-wide and takes effect only before the first random number is drawn, so
 each run needs a fresh process: `run_ompl_isolated` (used by bench_planner.py) starts one; run as a
@@ -37,7 +38,7 @@ def turning_radius(vehicle: dict) -> float:
 
 
 def make_pose_checker(scenario: dict) -> Callable[[float, float], bool]:
-    """Return `is_free(x, y)`, FORMAT.md's pose validity (heading never matters).
+    """Return `is_free(x, y)`, docs/scenario-format.md's pose validity (heading never matters).
 
     Plain Python floats and precomputed tuples: OMPL calls this for every checked pose, and a
     numpy call per pose would cost more than the arithmetic it does.
@@ -110,7 +111,8 @@ def _near_edge(x: float, y: float, edges: list, r2: float) -> bool:
 
 
 def ompl_setup(scenario: dict) -> OmplSetup:
-    """A FORMAT.md scenario as the bridge's set-up, checked by the pure-Python checker."""
+    """A scenario (docs/scenario-format.md) as the bridge's set-up, checked by the pure-Python
+    checker."""
     is_free = make_pose_checker(scenario)
     tolerance = scenario.get("goal_tolerance", {})
     return OmplSetup(tuple(scenario["bounds"]), tuple(scenario["start"]), tuple(scenario["goal"]),
@@ -138,7 +140,8 @@ def run_ompl_isolated(scenario: dict, planner: str, time_limit: float, seed: int
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scenario", help="scenario JSON file (FORMAT.md), or - for stdin")
+    parser.add_argument("scenario", 
+                        help="scenario JSON file (docs/scenario-format.md), or - for stdin")
     parser.add_argument("--planner", choices=sorted(PLANNERS), default="RRTstar")
     parser.add_argument("--time-limit", type=float, default=1.0, help="seconds (default 1)")
     parser.add_argument("--seed", type=int, default=0)

@@ -73,7 +73,7 @@ class Tree(NamedTuple):
     grid: np.ndarray  # float64[5]: x0, y0, cell size, nx, ny
     goal_nodes: np.ndarray  # (cap,) int64
     improved: np.ndarray  # (cap, 2): iteration and best cost at each improvement (cnt[IMPROVED])
-    cnt: np.ndarray  # int64[9], see the counter indices
+    cnt: np.ndarray  # int64[NCOUNTERS], see the counter indices
     rng: np.ndarray  # uint64[4]
     near: np.ndarray  # scratch (cap,) int64
     near_len: np.ndarray  # scratch (cap,)

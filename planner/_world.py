@@ -1,10 +1,10 @@
 """The world as flat arrays for compiled kernels: bounds, obstacles, motions, drivable region.
 
-Collision semantics are FORMAT.md's: a pose at time t is valid iff the car's footprint discs
-(one disc of radius r, or the discs covering a rectangle) are inside the bounds, strictly clear
-of every obstacle where that obstacle is at time t, and (for a track) inside the drivable region.
-`clearance` returns the signed distance from the discs to the nearest forbidden point, so "valid"
-is ``clearance > 0``.
+Collision semantics are the scenario format's (docs/scenario-format.md): a pose at time t is valid
+iff the car's footprint discs (one disc of radius r, or the discs covering a rectangle) are inside
+the bounds, strictly clear of every obstacle where that obstacle is at time t, and (for a track)
+inside the drivable region. `clearance` returns the signed distance from the discs to the nearest
+forbidden point, so "valid" is ``clearance > 0``.
 
 Motion checks are exact, not sampled ("sphere tracing"): at a pose with clearance d nothing can
 be hit before the car has driven d / (1 + v_obs/v) further, since the car's position moves at
@@ -156,7 +156,7 @@ def without_movers(world: World) -> World:
 
 @njit(cache=True)
 def offset(w: World, m: int, t: float):
-    """Translation (dx, dy) of motion ``m`` at time t (FORMAT.md v1.1 semantics)."""
+    """Translation (dx, dy) of motion ``m`` at time t (docs/scenario-format.md v1.1 semantics)."""
     if w.m_kind[m] == VELOCITY:
         return w.m_vel[m, 0] * t, w.m_vel[m, 1] * t
     a = w.m_wp_start[m]
@@ -301,7 +301,8 @@ def _fill_lane(w: World, centreline: np.ndarray) -> None:
 def pose_clearance(w: World, x: float, y: float, th: float, t: float) -> float:
     """Signed clearance of the car's footprint at pose (x, y, th) at time t; > 0 means valid.
 
-    ``t`` NaN means "static obstacles only" (FORMAT.md: the goal has no time condition).
+    ``t`` NaN means "static obstacles only" (docs/scenario-format.md: the goal has no time
+    condition).
     """
     c = math.inf
     for k in range(w.discs.shape[0]):
@@ -328,8 +329,8 @@ def moving_clearance(w: World, x: float, y: float, th: float, t: float) -> float
 
 @njit(cache=True)
 def clearance(w: World, x: float, y: float, t: float) -> float:
-    """Clearance of a car heading along +x at (x, y): exact for disc footprints (FORMAT.md),
-    where the heading does not matter."""
+    """Clearance of a car heading along +x at (x, y): exact for disc footprints
+    (docs/scenario-format.md), where the heading does not matter."""
     return pose_clearance(w, x, y, 0.0, t)
 
 

@@ -1,7 +1,7 @@
 """OMPL's planners on our problems: the baseline of the benchmarks and the ``ompl:*`` targets
 of studies (needs the ``bench`` extra: ``pip install 'trackstar[bench]'``).
 
-The problem is set up as docs/scenario-format.md (FORMAT.md) defines comparisons: Dubins (or
+The problem is set up as docs/scenario-format.md defines comparisons: Dubins (or
 Reeds-Shepp) state space with our turning radius, poses checked every 0.02 m along motions, a
 goal region with position and heading tolerances whose one goal sample is the exact goal pose,
 path length as the objective with a cost threshold of 0 (the optimising planners use the whole
@@ -25,6 +25,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from planner.steering import DEFAULT_STEERING, STEERINGS
+
 __all__ = ["CHECK_STEP_M", "OMPL_PARAMETERS", "OMPL_PLANNERS", "OmplSetup", "available", "plan", "plan_isolated",
            "setup_from_problem"]
 
@@ -34,8 +36,8 @@ OMPL_PLANNERS = {"ompl:rrt": "RRT", "ompl:rrtstar": "RRTstar",
 # The options each takes, under our names: eps is OMPL's range, goal_bias its goal bias.
 OMPL_PARAMETERS = {"RRT": ("eps", "goal_bias"), "RRTstar": ("eps", "goal_bias"),
                    "InformedRRTstar": ("eps", "goal_bias"), "BITstar": ()}
-STEERING_SPACES = {"dubins": "DubinsStateSpace", "reeds-shepp": "ReedsSheppStateSpace"}
-CHECK_STEP_M = 0.02  # OMPL's motion-check resolution, as FORMAT.md asks for comparisons
+STEERING_SPACES = {s.name: s.ompl_space for s in STEERINGS.values() if s.ompl_space}
+CHECK_STEP_M = 0.02  # OMPL's motion checks, as docs/scenario-format.md asks for comparisons
 RECHECK_STEP_M = 0.005  # re-check of the returned path: OMPL may clip a corner between samples
 
 
@@ -81,9 +83,9 @@ def _wrap(angle: float) -> float:
 
 
 def _pose_goal(ob, si, setup: OmplSetup):
-    """FORMAT.md's goal region as an OMPL goal: distanceGoal <= 0 exactly inside it (threshold
-    0); its one sample is the exact goal pose, the goal bias of RRT*, and where BIT* (which
-    reaches the goal only through goal samples) ends its paths."""
+    """The goal region (docs/scenario-format.md) as an OMPL goal: distanceGoal <= 0 exactly inside
+    it (threshold 0); its one sample is the exact goal pose, the goal bias of RRT*, and where BIT*
+    (which reaches the goal only through goal samples) ends its paths."""
 
     class PoseGoal(ob.GoalSampleableRegion):
         def __init__(self) -> None:
@@ -185,7 +187,7 @@ def _path_poses(space, path, step: float):
             yield pose.getX(), pose.getY(), pose.getYaw()
 
 
-def plan(setup: OmplSetup, planner: str, steering: str = "dubins", *, seed: int = 0,
+def plan(setup: OmplSetup, planner: str, steering: str = DEFAULT_STEERING, *, seed: int = 0,
          time_limit: float | None = None, iterations: int | None = None,
          eps: float | None = None, goal_bias: float | None = None) -> dict:
     """Plan once with OMPL's ``planner`` (a class name of `OMPL_PLANNERS`); the seed is

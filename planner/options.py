@@ -13,7 +13,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from planner.scenario import Margin, ScenarioError, Speed
-from planner.steering import STEERINGS, SteeringName
+from planner.steering import DEFAULT_STEERING, STEERINGS, SteeringName
 
 __all__ = ["METRICS", "PLANNERS", "TIMINGS", "PlanOptions", "PositiveFinite", "Seed"]
 
@@ -40,7 +40,7 @@ class PlanOptions(BaseModel):
         "rrtstar", description="Planning algorithm: RRT stops at its first solution, RRT* "
                                "goes on improving it.")
     steering: SteeringName = Field(
-        next(iter(STEERINGS)), description="Steering: " + "; ".join(
+        DEFAULT_STEERING, description="Steering: " + "; ".join(
             f"{s.name} {s.summary}" for s in STEERINGS.values()) + ".")
     time: PositiveFinite | None = Field(
         None, description="Time budget in seconds [default: 1.0, or none when an iteration "

@@ -23,7 +23,7 @@ from planner._steer import steer_path
 from planner._world import World, inflated
 from planner.options import METRICS, PlanOptions
 from planner.problem import Problem, check_room
-from planner.steering import STEERINGS
+from planner.steering import DEFAULT_STEERING, STEERINGS
 from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points, path_points
 
 __all__ = ["Planner", "Result", "checked_world", "warm_up"]
@@ -439,7 +439,7 @@ def warm_up() -> None:
     # One kernel serves every planner and steering (they are parameters, not types). Unsolved
     # after 40 iterations: the path kernels load with a plan's first result, not with every
     # process (a plan of one iteration, a worker's first job).
-    p = Planner(problem, PlanOptions(planner="rrtstar", steering="dubins"))
+    p = Planner(problem, PlanOptions(planner="rrtstar", steering=DEFAULT_STEERING))
     p.step(40)
     p.result()
     _warm = True

@@ -1,4 +1,4 @@
-"""Scenarios: the shared minimal format (FORMAT.md v1–v1.2) and Trackstar's richer schema.
+"""Scenarios: the minimal format (docs/scenario-format.md v1–v1.2) and Trackstar's richer schema.
 
 One pydantic model reads both, because the rich schema is a superset: a scenario may name a
 library track as its drivable region (then ``bounds`` may be omitted), use oriented boxes, and
@@ -113,7 +113,8 @@ class Footprint(StrictModel):
 class Vehicle(StrictModel):
     """The car: geometry for planning (v1), speed (v1.1) and limits for simulation (v1.2).
 
-    The footprint is a disc of ``radius`` (FORMAT.md) or, in the rich schema, a rectangle.
+    The footprint is a disc of ``radius`` (docs/scenario-format.md) or, in the rich schema, a
+    rectangle.
     """
 
     wheelbase: Annotated[float, Field(gt=0, le=MAX_WHEELBASE_M)] = 0.44
@@ -351,8 +352,9 @@ def bundled_scenario_path(name: str) -> Path:
 
 
 def load_scenario(source: str | Path) -> Scenario:
-    """Read and validate a scenario: a file (minimal FORMAT.md or the rich schema) or, when no
-    such file exists, the name of a bundled scenario (``load_scenario("slalom")``)."""
+    """Read and validate a scenario: a file (the minimal format of docs/scenario-format.md or
+    the rich schema) or, when no such file exists, the name of a bundled scenario
+    (``load_scenario("slalom")``)."""
     path = Path(source)
     if not path.is_file() and str(source) in scenario_names():
         path = bundled_scenario_path(str(source))

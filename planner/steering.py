@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-__all__ = ["STEERINGS", "Steering", "SteeringName"]
+__all__ = ["DEFAULT_STEERING", "STEERINGS", "Steering", "SteeringName"]
 
 DUBINS, REEDS_SHEPP, STRAIGHT = range(3)  # the kernel's codes (`_steer.py` dispatches on them)
 
@@ -25,7 +25,9 @@ class Steering:
     position, a rectangular footprint (whose sweep a turn on the spot would ignore) is refused,
     and RRT*'s near radius shrinks as in the plane (d = 2) instead of in (x, y, θ) (d = 3).
     ``curved``: it drives arcs of curvature up to 1/ρ, so the chords between a path's rows stray
-    from it (`planner._rows.chord_sag`).
+    from it (`planner._rows.chord_sag`). ``curvature``: what its paths' curvature profile looks
+    like (the studio's caption). ``ompl_space``: OMPL's state space of the same paths (None: OMPL
+    has none).
     """
 
     name: str
@@ -34,16 +36,28 @@ class Steering:
     reverses: bool
     heading_free: bool
     summary: str
+    curvature: str
+    ompl_space: str | None = None
     curved: bool = True
 
 
 STEERINGS = {s.name: s for s in (
-    Steering("dubins", "Dubins", DUBINS, False, False, "forward only (Dubins 1957)"),
+    Steering("dubins", "Dubins", DUBINS, False, False, "forward only (Dubins 1957)",
+             "Dubins paths are arcs at the tightest turn and straights: the path's κ is +1/ρ, "
+             "−1/ρ or 0 and jumps between them (bang-bang), never in between; ±κmax = 1/ρ.",
+             "DubinsStateSpace"),
     Steering("reeds-shepp", "Reeds-Shepp", REEDS_SHEPP, True, False,
-             "forward and reverse (Reeds & Shepp 1990)"),
+             "forward and reverse (Reeds & Shepp 1990)",
+             "Reeds-Shepp paths are arcs at the tightest turn and straights, forward or in "
+             "reverse: κ is ±1/ρ or 0 (bang-bang). Shaded: driven in reverse; ◆ on the zero "
+             "line: a cusp, where the car stops and changes direction.",
+             "ReedsSheppStateSpace"),
     Steering("straight", "Straight line", STRAIGHT, False, True,
              "straight lines for a point or disc robot that turns on the spot, goal by "
-             "position (the classic RRT picture, LaValle 1998)", curved=False),
+             "position (the classic RRT picture, LaValle 1998)",
+             "Straight lines: κ = 0 all along; the robot turns on the spot between them.",
+             curved=False),
 )}
+DEFAULT_STEERING = next(iter(STEERINGS))
 
 SteeringName = Literal[tuple(STEERINGS)]  # the names, for pydantic and typer

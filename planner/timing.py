@@ -40,7 +40,7 @@ MAX_STEP_S = 0.1  # docs/scenario-format.md v1.3: entries at most `SPACING_M` an
 EXTRA_WAIT_S = 60.0  # how long past the top-speed arrival a schedule may wait, at least
 MAX_WAIT_S = 600.0  # … and at most, whatever the waypoints' times
 MAX_CELLS = 4_000_000  # s–t grid points; a longer path or horizon gets coarser stations
-MAX_ROWS = 200_000  # path entries of a timed path (FORMAT.md spacing): about 10 MB of JSON
+MAX_ROWS = 200_000  # path entries of a timed path (docs/scenario-format.md): about 10 MB of JSON
 PROBE_SHARE = 0.2  # of a time budget, for each tree before the leader takes the rest
 
 
@@ -62,7 +62,7 @@ class Schedule:
 
     @property
     def spacing_m(self) -> float:
-        """FORMAT.md v1.3's: entries at most 0.05 m apart, and 0.1 s at vmax."""
+        """docs/scenario-format.md v1.3's: entries at most 0.05 m apart, and 0.1 s at vmax."""
         return min(SPACING_M, MAX_STEP_S * self.vmax)
 
     @property

@@ -1,12 +1,13 @@
-"""An independent validity checker for planned paths, written from FORMAT.md alone.
+"""An independent validity checker for planned paths, written from docs/scenario-format.md alone.
 
-Plain numpy, no planner code: it joins consecutive path points by the arc the two poses define
-(or by the straight chord, as a consumer of the rows does), densifies, and tests every pose
-against the scenario's obstacles where they are at that instant, and against a track's drivable
-region when the scene gives its rings (``region``, even-odd). The car is FORMAT.md's disc of ``vehicle.radius`` or, in the rich schema
-(docs/planner.md), the rectangle ``vehicle.footprint`` at its exact outline (not the discs the
-planner covers it with): the pose is the rear axle, the rectangle runs ``rear_overhang`` behind
-it and ``length - rear_overhang`` ahead along the heading, ``width / 2`` to either side.
+Plain numpy, no planner code: it joins consecutive path points by the arc the two poses define (or
+by the straight chord, as a consumer of the rows does), densifies, and tests every pose against the
+scenario's obstacles where they are at that instant, and against a track's drivable region when the
+scene gives its rings (``region``, even-odd). The car is the format's disc of ``vehicle.radius`` or,
+in the rich schema (docs/planner.md), the rectangle ``vehicle.footprint`` at its exact outline (not
+the discs the planner covers it with): the pose is the rear axle, the rectangle runs
+``rear_overhang`` behind it and ``length - rear_overhang`` ahead along the heading, ``width / 2`` to
+either side.
 """
 
 from __future__ import annotations
@@ -145,8 +146,8 @@ def _rectangle_valid(scn: dict, rect, x: float, y: float, theta: float,
 
 def pose_valid(scn: dict, x: float, y: float, t: float | None,
                theta: float | None = None) -> bool:
-    """FORMAT.md validity at time t (None: static obstacles only). A rectangle footprint
-    (rich schema) needs the heading ``theta``; a disc car ignores it."""
+    """Validity (docs/scenario-format.md) at time t (None: static obstacles only). A rectangle
+    footprint (rich schema) needs the heading ``theta``; a disc car ignores it."""
     if theta is None and footprint(scn.get("vehicle", {})) is not None:
         raise ValueError("a rectangle footprint is checked at a heading: give theta")
     pose = np.array([[x, y, 0.0 if theta is None else theta]])
@@ -171,7 +172,7 @@ def poses_valid(scn: dict, poses: np.ndarray, times: np.ndarray | None) -> np.nd
 
 def _discs_valid(scn: dict, poses: np.ndarray, times: np.ndarray | None,
                  r: float) -> np.ndarray:
-    """FORMAT.md's test of a disc car of radius r, per pose."""
+    """docs/scenario-format.md's test of a disc car of radius r, per pose."""
     x, y = poses[:, 0], poses[:, 1]
     xmin, ymin, xmax, ymax = scn["bounds"]
     valid = (xmin + r <= x) & (x <= xmax - r) & (ymin + r <= y) & (y <= ymax - r)
@@ -309,7 +310,7 @@ def arc_mismatch(path) -> float:
 
 
 def schedule_errors(path, max_speed: float, rounding: float = 0.0) -> list[str]:
-    """FORMAT.md v1.3's rules for a timed path of ``timing: optimal``: t from 0 and
+    """docs/scenario-format.md v1.3's rules for a timed path of ``timing: optimal``: t from 0 and
     non-decreasing, at most ``max_speed`` between entries (1 % tolerance, and ``rounding`` m
     for rows rounded to that many metres and seconds), entries at most 0.05 m and 0.1 s apart.
     Returns one message per kind of breach."""

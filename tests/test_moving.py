@@ -1,4 +1,4 @@
-"""Moving obstacles (FORMAT.md v1.1): offsets, space-time planning, timed paths."""
+"""Moving obstacles (docs/scenario-format.md v1.1): offsets, space-time planning, timed paths."""
 
 import math
 
@@ -39,7 +39,7 @@ def test_crossing_is_planned_around_the_disc_in_space_time():
     assert result.solved
     path = result.path[:, [0, 1, 2, 5]]
     assert first_collision(scn, path) is None
-    # Times are the driven length over the speed (FORMAT.md: within 1 % + 0.02 s).
+    # Times are the driven length over the speed (docs/scenario-format.md: within 1 % + 0.02 s).
     driven = np.concatenate([[0], np.cumsum(np.hypot(*np.diff(path[:, :2], axis=0).T))])
     assert np.all(np.abs(path[:, 3] - driven) <= 0.01 * driven + 0.02)
     assert path[-1, 3] == pytest.approx(result.cost, rel=1e-3)

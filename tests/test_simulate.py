@@ -2,7 +2,7 @@
 
 Independent checks: the log is replayed with the exact-arc formula written out here, limits are
 re-derived from the log, and collisions are recounted with tests/checker.py (plain numpy from
-FORMAT.md), never with the simulator's own clearance code.
+docs/scenario-format.md), never with the simulator's own clearance code.
 """
 
 from __future__ import annotations
@@ -53,7 +53,8 @@ def _replay_error(log: np.ndarray, wheelbase: float, dt: float) -> float:
 
 
 def _as_polygons(scn: dict) -> dict:
-    """Boxes written out as their corner polygons (FORMAT.md: centre, size, angle_deg)."""
+    """Boxes written out as their corner polygons (docs/scenario-format.md: centre, size,
+    angle_deg)."""
     out = []
     for ob in scn["obstacles"]:
         if ob["type"] == "box":

@@ -83,11 +83,20 @@ def test_triangle_inequality(steering, q0, q1, q2):
 @steerings
 @settings(max_examples=100, deadline=None)
 @given(q0=pose, q1=pose)
-def test_symmetric_where_the_robot_may_go_back(steering, q0, q1):
+def test_symmetric_where_the_robot_may_go_back_and_under_flipped_headings(steering, q0, q1):
+    """q0 → q1 is as long as q1 → q0 where the robot may reverse or turn on the spot; for
+    every steering, it is as long as the same curve driven the other way: from q1 to q0 with
+    both headings turned round."""
     assume(distinct(q0, q1))
     there, back = shortest(steering.code, q0, q1)[0], shortest(steering.code, q1, q0)[0]
     if steering.reverses or steering.heading_free:
         assert there == pytest.approx(back, abs=1e-9)
+
+    def turned(q):
+        return (q[0], q[1], q[2] + math.pi)
+
+    flipped = shortest(steering.code, turned(q1), turned(q0))[0]
+    assert there == pytest.approx(flipped, abs=1e-9)
 
 
 @settings(max_examples=100, deadline=None)

@@ -1,5 +1,6 @@
-"""Time-optimal planning (``timing: optimal``): waits for movers, FORMAT.md v1.3 rows checked by
-the independent checker, never later than the constant-speed plan of the same trees."""
+"""Time-optimal planning (``timing: optimal``): waits for movers, docs/scenario-format.md v1.3
+rows checked by the independent checker, never later than the constant-speed plan of the same
+trees."""
 
 from __future__ import annotations
 

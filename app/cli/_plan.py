@@ -19,7 +19,7 @@ scenario_cli = typer.Typer(help="Scenarios: the bundled ones, validation and the
 
 ScenarioArg = Annotated[str, typer.Argument(
     show_default=False, help="A bundled scenario's name (trackstar scenario list) or a scenario "
-                             "JSON file (FORMAT.md or the rich schema).")]
+                             "JSON file (docs/scenario-format.md or the rich schema).")]
 
 
 @model_options(PlanOptions)

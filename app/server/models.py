@@ -136,7 +136,8 @@ class ScenarioRecord(BaseModel):
     id: str = Field(description="bundled scenarios: their name; posted ones: a generated id")
     name: str
     source: Literal["library", "upload"]
-    scenario: dict[str, Any] = Field(description="as posted (FORMAT.md or the rich schema)")
+    scenario: dict[str, Any] = Field(
+        description="as posted (docs/scenario-format.md or the rich schema)")
 
 
 class PlanRequest(PlanOptions, _OneScenario):
@@ -146,7 +147,7 @@ class PlanRequest(PlanOptions, _OneScenario):
         json_schema_extra={"examples": [{"scenario": SCENARIO_EXAMPLE, "time": 0.5}]})
 
     scenario: ScenarioBody | None = Field(
-        None, description="FORMAT.md or the rich schema (GET /scenarios/schema)")
+        None, description="docs/scenario-format.md or the rich schema (GET /scenarios/schema)")
     scenario_id: str | None = None
 
 
@@ -203,7 +204,7 @@ class SimulationRequest(SimOptions, _OneScenario):
         {"scenario_id": "<a stored thesis-track scenario>", "laps": 2}]})
 
     scenario: ScenarioBody | None = Field(
-        None, description="FORMAT.md or the rich schema (GET /scenarios/schema)")
+        None, description="docs/scenario-format.md or the rich schema (GET /scenarios/schema)")
     scenario_id: str | None = None
 
     def options(self) -> SimOptions:

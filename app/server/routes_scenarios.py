@@ -53,7 +53,8 @@ def resolve(request: Request, scenario: planner.Scenario | str
 
 @router.get("/scenarios/schema")
 def schema() -> dict:
-    """The JSON Schema of the rich scenario format (FORMAT.md scenarios are valid too)."""
+    """The JSON Schema of the rich scenario format (minimal ones, docs/scenario-format.md, are
+    valid too)."""
     return planner.scenario_schema()
 
 
@@ -62,8 +63,9 @@ async def create_scenario(
     request: Request,
     scenario: Annotated[ScenarioBody, Body(examples=[SCENARIO_EXAMPLE])],
 ) -> ScenarioRecord:
-    """Store a scenario (FORMAT.md or the rich schema) once it is known to be plannable: valid
-    fields, start and goal free. Its track may be a library name or an uploaded track's id."""
+    """Store a scenario (docs/scenario-format.md or the rich schema) once it is known to be
+    plannable: valid fields, start and goal free. Its track may be a library name or an uploaded
+    track's id."""
     scenario, track = resolve(request, scenario)
     await request.app.state.planning.check(scenario, track)
     # Stored as posted, not as the parsed model (which would add every default): the JSON

@@ -24,6 +24,7 @@ import numpy as np
 import tracks
 from app.studio._compare import CURRENT, cost_curves, hex_rgb
 from app.studio._scene import arc_length, cusp_rows, reversing
+from planner.steering import DEFAULT_STEERING, STEERINGS
 
 __all__ = ["Profiles"]
 
@@ -88,15 +89,6 @@ def _series(label: str, stroke: str | None = None, width: float = 1.5, dash=None
 # Arc length and seconds are plain numbers: uPlot's x axis would otherwise show dates.
 NUMERIC_X = {"x": {"time": False}}
 SHADE = 1.15  # the reverse shading reaches this times the limit, above and below
-CAPTIONS = {  # what the path's curvature looks like, per steering
-    "dubins": "Dubins paths are arcs at the tightest turn and straights: the path's κ is "
-              "+1/ρ, −1/ρ or 0 and jumps between them (bang-bang), never in between; "
-              "±κmax = 1/ρ.",
-    "reeds-shepp": "Reeds-Shepp paths are arcs at the tightest turn and straights, forward or "
-                   "in reverse: κ is ±1/ρ or 0 (bang-bang). Shaded: driven in reverse; "
-                   "◆ on the zero line: a cusp, where the car stops and changes direction.",
-    "straight": "Straight lines: κ = 0 all along; the robot turns on the spot between them.",
-}
 
 
 def _reverse_on(grid: np.ndarray, path: np.ndarray) -> np.ndarray:
@@ -153,7 +145,7 @@ class Profiles:
         self._cusps: tuple = ()  # the grid indices of the current path's cusps
         kappa, steer, speed = map(_for_uplot, self._profiles(np.zeros((0, 4))))
         common = {"aspect": 1.6, "bands": band, "legend": {"show": True}, "scales": NUMERIC_X}
-        self.caption = gui.add_markdown(CAPTIONS["dubins"])
+        self.caption = gui.add_markdown(STEERINGS[DEFAULT_STEERING].curvature)
         self.curvature = gui.add_uplot(
             kappa, (_series("s (m)"), _series("centreline κ", "#4a90e2"),
                     _series("path κ", CURRENT, 2.0), _series("+κmax", "#2e9e5b", 1, [4, 4]),
@@ -183,7 +175,7 @@ class Profiles:
 
     def set_steering(self, name: str) -> None:
         """The caption for paths of this steering (`planner.STEERINGS`' names)."""
-        self.caption.content = CAPTIONS[name]
+        self.caption.content = STEERINGS[name].curvature
 
     @property
     def _others(self) -> list:

@@ -8,7 +8,7 @@
 The scenario is a bundled scenario's name or a scenario file.
 
 Approach points are drawn with their tolerance circles, transitions as ticks on the path, the
-goal region in green. FORMAT.md scenes (circles, polygons) only; needs matplotlib.
+goal region in green. docs/scenario-format.md scenes (circles, polygons) only; needs matplotlib.
 """
 
 from __future__ import annotations

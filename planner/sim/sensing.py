@@ -1,7 +1,7 @@
 """What the car knows: sensed obstacle offsets and velocity estimates, and pose measurements.
 
-The true motion of every obstacle (FORMAT.md v1.1 `motion`) is evaluated here in plain numpy, for
-the sensors and the log; the planner only ever sees the `Sensing` records these produce.
+The true motion of every obstacle (docs/scenario-format.md v1.1 `motion`) is evaluated here in plain
+numpy, for the sensors and the log; the planner only ever sees the `Sensing` records these produce.
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ class Limits:
 
     @classmethod
     def of(cls, vehicle) -> Limits:
-        """From a scenario `Vehicle` (FORMAT.md v1.2 fields, defaults applied)."""
+        """From a scenario `Vehicle` (docs/scenario-format.md v1.2 fields, defaults applied)."""
         return cls(wheelbase=vehicle.wheelbase, max_steer=math.radians(vehicle.max_steer_deg),
                    max_steer_rate=math.radians(vehicle.max_steer_rate_deg_s),
                    max_speed=vehicle.max_speed if vehicle.max_speed is not None else vehicle.speed,
