@@ -15,10 +15,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import ConfigDict, Field
 
 from app.planning import TrackSource, track_loader
 from planner.options import TIMINGS, Seed
+from planner.validation import KnownKeys
 
 __all__ = ["MAX_DURATION_S", "SimOptions", "SimulationStopped", "read_progress",
            "run_simulation"]
@@ -34,7 +35,7 @@ Rate = Annotated[float, Field(ge=MIN_RATE_HZ, le=MAX_RATE_HZ, allow_inf_nan=Fals
 PROGRESS_EVERY_S = 0.25  # wall time between progress writes
 
 
-class SimOptions(BaseModel):
+class SimOptions(KnownKeys):
     """How to simulate: the options of `trackstar simulate`, with the same defaults."""
 
     model_config = ConfigDict(extra="forbid")

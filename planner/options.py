@@ -10,10 +10,11 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import ConfigDict, Field
 
 from planner.scenario import Margin, ScenarioError, Speed
 from planner.steering import DEFAULT_STEERING, STEERINGS, SteeringName
+from planner.validation import KnownKeys
 
 __all__ = ["METRICS", "PLANNERS", "TIMINGS", "PlanOptions", "PositiveFinite", "Seed"]
 
@@ -31,7 +32,7 @@ Length = Annotated[float, Field(gt=0, le=MAX_EPS_M, allow_inf_nan=False)]
 Seed = Annotated[int, Field(ge=0, lt=2**64)]
 
 
-class PlanOptions(BaseModel):
+class PlanOptions(KnownKeys):
     """Every option of a planning run, with its default; the budget (time, iterations) too."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, defer_build=True)

@@ -243,6 +243,24 @@ def test_bad_scenarios_are_422_naming_the_field(server, body, words):
         assert words in json.dumps(resp.json()["detail"]), (path, resp.text)
 
 
+@pytest.mark.parametrize("path, body, words", [
+    ("/plan", {"scenario_id": "x", "tme": 1}, "unknown key 'tme' (did you mean 'time'?)"),
+    ("/plan", {"scenario_id": "x", "steering": "dubin"},
+     "'dubin' is not a steering (did you mean 'dubins'?)"),
+    ("/jobs", {"scenarios": ["x"], "sedes": [1]}, "unknown key 'sedes' (did you mean 'seeds'?)"),
+    ("/jobs", {"scenarios": ["x"], "parameters": [{"planer": "rrt"}]},
+     "unknown key 'planer' (did you mean 'planner'?)"),
+    ("/simulations", {"scenario_id": "x", "rate_hz": 3},
+     "unknown key 'rate_hz' (did you mean 'rate'?)"),
+    ("/simulations", {"scenario_id": "x", "timing": "fast"},
+     "'fast' is not a timing (use one of constant, optimal)"),
+])
+def test_bad_options_are_422_naming_the_value_and_the_nearest_key(server, path, body, words):
+    resp = server.client.post(path, json=body)
+    assert resp.status_code == 422, resp.text
+    assert words in json.dumps(resp.json()["detail"]), resp.text
+
+
 def test_openapi_carries_the_scenario_schema_in_every_body(server):
     spec = server.get("/openapi.json").json()
     schemas = spec["components"]["schemas"]

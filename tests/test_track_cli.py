@@ -76,6 +76,24 @@ def test_sample_csv_with_path_wheelbase_and_steering_limit(tmp_path):
     assert on_arc and all(r["feasible"] == "False" for r in on_arc)  # atan(0.02·50) = 45° > 30°
 
 
+def test_sampling_an_element_of_several_subpaths_says_which_one_it_took(tmp_path):
+    """A ring drawn as one path with its inner edge: --path ring takes the longest subpath,
+    and says so on stderr and in the JSON; ring:1 chooses the inner one, without a note."""
+    svg = tmp_path / "ring.svg"
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="50mm" '
+                   'viewBox="0 0 100 50"><path id="ring" stroke-width="2" '
+                   'd="M15 15 h20 v20 h-20 z M10 10 h30 v30 h-30 z"/></svg>')
+    note = "ring has 2 subpaths; took ring:1, the longest; choose one with ring:N"
+    done, _ = run("sample", str(svg), "--path", "ring", "--json")
+    assert done.returncode == 0 and done.stderr.strip() == note
+    data = json.loads(done.stdout)
+    assert data["note"] == note and data["length_m"] == pytest.approx(0.12)
+    done, _ = run("sample", str(svg), "--path", "ring:0", "--json")
+    assert done.returncode == 0 and done.stderr == ""
+    data = json.loads(done.stdout)
+    assert "note" not in data and data["length_m"] == pytest.approx(0.08)
+
+
 def test_plot_writes_a_figure(tmp_path):
     for name in ("profile.png", "profile.svg"):
         done, _ = run("plot", "carolo", "-o", str(tmp_path / name))

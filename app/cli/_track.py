@@ -64,9 +64,33 @@ def _source(file: str) -> Path:
 
 
 def _load(file: str, path_id: str | None, unit: str | None, open_: bool):
-    from tracks import load_track
+    """The track, with a line on stderr when ``path_id`` names an element of several subpaths
+    (its longest is taken: a drawing's inner edge, say, may be the one wanted)."""
+    track, note = _load_noted(file, path_id, unit, open_)
+    if note:
+        print(note, file=sys.stderr)
+    return track
 
-    return load_track(_source(file), path_id=path_id, unit=unit, closed=False if open_ else None)
+
+def _load_noted(file: str, path_id: str | None, unit: str | None, open_: bool):
+    """The track and the note `_load` prints (None: nothing to say)."""
+    from tracks import inspect_track, load_track
+
+    source, closed = _source(file), False if open_ else None
+    track = load_track(source, path_id=path_id, unit=unit, closed=closed)
+    if path_id is None:
+        return track, None
+    paths = inspect_track(source, unit=unit, closed=closed)["paths"]
+    element = next((p for p in paths if p["subpath"] is None
+                    and path_id in (p["selector"], p["id"], p["label"])), None)
+    if element is None:
+        return track, None  # a NAME:K selector, or a CSV
+    parts = [p for p in paths if p["selector"].startswith(element["selector"] + ":")]
+    if len(parts) < 2:
+        return track, None
+    longest = max(parts, key=lambda p: p["length_m"])["selector"]
+    return track, (f"{path_id} has {len(parts)} subpaths; took {longest}, the longest; "
+                   f"choose one with {element['selector']}:N")
 
 
 def _write(text: str, output: Path | None) -> None:
@@ -124,9 +148,12 @@ def sample(
         from tracks import check_sampling
 
         check_sampling(spacing, wheelbase, max_steer_deg)
-        profile = _load(file, path, unit, open_).sample(spacing, wheelbase, max_steer_deg)
+        track, note = _load_noted(file, path, unit, open_)
+        profile = track.sample(spacing, wheelbase, max_steer_deg)
+    if note:
+        print(note, file=sys.stderr)
     if as_json:
-        print(json.dumps(profile.to_dict()))
+        print(json.dumps({**profile.to_dict(), **({"note": note} if note else {})}))
     elif as_csv:
         writer = csv.DictWriter(sys.stdout, fieldnames=profile.COLUMNS, lineterminator="\n")
         writer.writeheader()

@@ -27,6 +27,7 @@ from app.server.jobs import Planning, WorkerCrashed
 from app.server.models import INVALID_SCENARIO, Health
 from app.server.store import Store
 from planner import ScenarioError
+from planner.validation import message
 
 STATIC = Path(__file__).resolve().parents[2] / "static"
 DATABASE = "trackstar.sqlite3"
@@ -149,7 +150,7 @@ def create_app(settings: ServerSettings) -> FastAPI:
     @app.exception_handler(RequestValidationError)
     async def invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
         # Without the echoed input: it may hold NaN or infinity, which JSON cannot carry.
-        errors = [{"loc": e["loc"], "msg": e["msg"], "type": e["type"]} for e in exc.errors()]
+        errors = [{"loc": e["loc"], "msg": message(e), "type": e["type"]} for e in exc.errors()]
         if errors and all(e["type"] == INVALID_SCENARIO for e in errors):
             # Only an inline scenario is wrong: its one-line message, as for any ScenarioError.
             return JSONResponse({"detail": _scenario_message(errors[0])}, status_code=422)

@@ -15,6 +15,7 @@ from app.simulation import SimOptions
 from planner.options import PlanOptions, Seed
 from planner.report import PlanReport
 from planner.scenario import Scenario, ScenarioError, parse_scenario
+from planner.validation import KnownKeys
 
 Point = tuple[float, float]
 
@@ -62,7 +63,7 @@ class _OneScenario(BaseModel):
         return data
 
 
-class _Body(BaseModel):
+class _Body(KnownKeys):
     model_config = ConfigDict(extra="forbid")
 
 

@@ -3,6 +3,7 @@ moment it finishes, then write its table and report."""
 
 from __future__ import annotations
 
+import shutil
 import sys
 import time
 from collections.abc import Callable
@@ -126,8 +127,11 @@ def run_study(study: Study, out: Path, workers: int, backend: str = "local") -> 
 
 
 def _run_on(backend, study: Study, todo: list, results: Results) -> None:
+    # A terminal that reports a size of 0 × 0 (a pty under script(1), some CI consoles) makes
+    # tqdm count -1 rows and draw nothing at all; shutil falls back to 80 × 24 there.
+    cols, rows = shutil.get_terminal_size()
     bar = tqdm(total=len(todo), desc=study.name, unit="run", file=sys.stderr,
-               disable=not sys.stderr.isatty())
+               disable=not sys.stderr.isatty(), ncols=cols, nrows=rows)
     pending: dict = {}
     queue = iter(todo)
     solved = 0
