@@ -109,7 +109,7 @@ def write_animation(frames: list[Frame], problem, title: str, path: Path, fps: i
             edges[n] = frame.tree.edge_points(n, EDGE_POINTS)
         tree_lines.set_segments([edges[n] for n in range(frame.tree.nodes)])
         rewired.set_segments([edges[n] for n in moved])
-        chain = _best_chain(frame.tree)
+        chain = frame.tree.best_path
         line = np.vstack([edges[n] for n in chain[1:]]) if len(chain) > 1 else np.zeros((0, 2))
         best.set_data(line[:, 0], line[:, 1])
         cost = f"best cost {frame.cost:.2f} m" if frame.cost is not None else "no path yet"
@@ -125,14 +125,6 @@ def write_animation(frames: list[Frame], problem, title: str, path: Path, fps: i
     plt.close(fig)
     images[0].save(path, save_all=True, append_images=images[1:], duration=1000 // fps,
                    loop=0)
-
-
-def _best_chain(tree: TreeSnapshot) -> list[int]:
-    chain, node = [], tree.best_node
-    while node >= 0:
-        chain.append(node)
-        node = int(tree.parent[node])
-    return chain[::-1]
 
 
 def _draw_world(ax, problem) -> None:

@@ -25,9 +25,10 @@ from typing import NamedTuple
 import numpy as np
 
 from planner._dubins import turning_centres
+from planner._goal import in_goal
 from planner._jit import njit
 from planner._paths import path_end, truncate, wrap_angle
-from planner._polish import PASSES, in_goal, polish_path
+from planner._polish import PASSES, polish_path
 from planner._rng import uniform
 from planner._steer import (
     arrival_heading,
@@ -480,24 +481,34 @@ def _subtree_free_at(tree: Tree, w: World, P: np.ndarray, n: int, delta: float,
 
 
 @njit(cache=True)
+def chain(parent: np.ndarray, node: int) -> np.ndarray:
+    """The nodes of the tree path from the root to ``node``, root first (none for -1): the one
+    walk up the parents, for the kernel, the planner's results and a snapshot alike."""
+    n = 0
+    k = node
+    while k >= 0:
+        n += 1
+        k = parent[k]
+    out = np.empty(n, np.int64)
+    k = node
+    for i in range(n - 1, -1, -1):
+        out[i] = k
+        k = parent[k]
+    return out
+
+
+@njit(cache=True)
 def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, counter, ev) -> bool:
     """Polish the best path (`planner._polish`) and, if that shortens it, add the polished
     poses to the tree as a chain from the root: the tree stays exact and RRT* goes on from it.
     Returns whether it added them."""
-    n = 0
-    node = tree.cnt[BEST]
-    while node >= 0:
-        n += 1
-        node = tree.parent[node]
+    nodes = chain(tree.parent, tree.cnt[BEST])
+    n = nodes.shape[0]
     # Each pass at most doubles the edges: the chain must fit whatever polishing makes of it.
     if n < 2 or tree.cnt[N] + (n - 1) * 2 ** PASSES > tree.pose.shape[0]:
         return False
-    poses = np.empty((n, 3))
-    node = root = tree.cnt[BEST]
-    for i in range(n - 1, -1, -1):
-        poses[i, :] = tree.pose[node]
-        root = node
-        node = tree.parent[node]
+    poses = tree.pose[nodes]
+    root = nodes[0]
     code = int(P[STEERING])
     goal = np.array([P[GX], P[GY], P[GTH], P[GPOS], P[GHEAD]])
     poses, length = polish_path(w, code, P[RHO], P[SPEED], poses, goal, kinds, lens, counter,

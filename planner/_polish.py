@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from planner._goal import in_goal
 from planner._jit import njit
 from planner._paths import pose_at, wrap_angle
 from planner._steer import state, steer_length, steer_path
@@ -36,13 +37,6 @@ BLOCKS = (2, 4, 8)  # poses shifted together, after the single-pose descent
 _D = math.sqrt(0.5)
 SHIFTS = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0], [_D, _D], [-_D, _D],
                    [_D, -_D], [-_D, -_D]])
-
-
-@njit(cache=True, inline="always")
-def in_goal(x: float, y: float, th: float, goal: np.ndarray) -> bool:
-    """Whether a pose is in the goal region ``goal`` = (x, y, θ, position tol, heading tol)."""
-    return (math.hypot(x - goal[0], y - goal[1]) <= goal[3]
-            and abs(wrap_angle(th - goal[2])) <= goal[4])
 
 
 @njit(cache=True, inline="always")

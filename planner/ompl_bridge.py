@@ -25,6 +25,9 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numpy as np
+
+from planner._goal import goal_offset
 from planner.steering import DEFAULT_STEERING, STEERINGS
 
 __all__ = ["CHECK_STEP_M", "OMPL_PARAMETERS", "OMPL_PLANNERS", "OmplSetup", "available", "plan", "plan_isolated",
@@ -77,15 +80,12 @@ def setup_from_problem(problem) -> OmplSetup:
                      lambda x, y, theta: clearance(x, y, theta) > problem.margin, clearance)
 
 
-def _wrap(angle: float) -> float:
-    """Angle wrapped to [-pi, pi)."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
-
-
 def _pose_goal(ob, si, setup: OmplSetup):
     """The goal region (docs/scenario-format.md) as an OMPL goal: distanceGoal <= 0 exactly inside
     it (threshold 0); its one sample is the exact goal pose, the goal bias of RRT*, and where BIT*
     (which reaches the goal only through goal samples) ends its paths."""
+
+    region = np.array([*setup.goal, setup.goal_position_tol, setup.goal_heading_tol])
 
     class PoseGoal(ob.GoalSampleableRegion):
         def __init__(self) -> None:
@@ -93,11 +93,7 @@ def _pose_goal(ob, si, setup: OmplSetup):
             self.setThreshold(0.0)
 
         def distanceGoal(self, state) -> float:
-            gx, gy, gtheta = setup.goal
-            off_position = math.hypot(state.getX() - gx, state.getY() - gy)
-            off_heading = abs(_wrap(state.getYaw() - gtheta))
-            return max(off_position - setup.goal_position_tol,
-                       off_heading - setup.goal_heading_tol)
+            return goal_offset(state.getX(), state.getY(), state.getYaw(), region)
 
         def sampleGoal(self, state) -> None:
             _set_pose(state, setup.goal)

@@ -41,6 +41,11 @@ class Problem:
         """The fastest the car may drive (timing optimal): vehicle.max_speed, else speed."""
         return self.max_speed if self.max_speed is not None else self.speed
 
+    def goal_region(self, share: float = 1.0) -> np.ndarray:
+        """The goal region as `planner._goal` tests it, its tolerances shrunk to ``share``."""
+        return np.array([*self.goal, share * self.goal_position_tol,
+                         share * self.goal_heading_tol])
+
     @property
     def bounds(self) -> tuple[float, float, float, float]:
         return tuple(float(v) for v in self.world.geo[:4])

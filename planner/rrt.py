@@ -274,12 +274,8 @@ class Planner:
 
     # -- results -----------------------------------------------------------------------------
     def best_path_nodes(self) -> list[int]:
-        node = int(self._tree.cnt[K.BEST])
-        chain = []
-        while node >= 0:
-            chain.append(node)
-            node = int(self._tree.parent[node])
-        return chain[::-1]
+        """The best path's nodes, root first (none before a solution)."""
+        return K.chain(self._tree.parent, int(self._tree.cnt[K.BEST])).tolist()
 
     def dense_path(self, spacing: float = SPACING_M) -> np.ndarray:
         """The best path sampled every ≤ spacing m: columns x, y, θ, κ, direction, t."""

@@ -12,6 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from planner._kernel import chain
 from planner._paths import path_length, sample_path
 
 __all__ = ["Rewire", "TreeEvents", "TreeSnapshot", "edge_points", "path_points"]
@@ -51,6 +52,11 @@ class TreeSnapshot:
     @property
     def nodes(self) -> int:
         return len(self.pose)
+
+    @property
+    def best_path(self) -> np.ndarray:
+        """The best path's nodes, root first (none before a solution)."""
+        return chain(self.parent, self.best_node)
 
     def edge_points(self, node: int, count: int = 4) -> np.ndarray:
         """(count + 1, 2) positions along the edge into ``node`` (see `edge_points`)."""

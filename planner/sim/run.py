@@ -16,6 +16,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from planner._goal import in_goal, in_goal_rows
 from planner._world import clearance, inflated, path_clearances
 from planner.options import TIMINGS, PlanOptions
 from planner.problem import Problem, compile_problem, resolve_track
@@ -135,19 +136,10 @@ class Frame:
     guard: str = "follow"  # what the guard has the car do: a key of `GUARD_CODES`
 
 
-def _in_goal(problem: Problem, x, y, th, share: float = 1.0):
-    """Whether the pose (scalars or arrays) is in the goal region shrunk to ``share`` of its
-    tolerances."""
-    gx, gy, gth = problem.goal
-    return ((np.hypot(x - gx, y - gy) <= share * problem.goal_position_tol)
-            & (np.abs(np.remainder(th - gth + math.pi, 2.0 * math.pi) - math.pi)
-               <= share * problem.goal_heading_tol))
-
-
 def _goal_arc(problem: Problem, ref: Reference) -> float:
     """The arc where ``ref`` is well inside the goal (half its tolerances: the car tracks it
     to a few cm), so the run ends there; inf if it does not get there."""
-    k = np.flatnonzero(_in_goal(problem, *ref.rows[:, :3].T, share=0.5))
+    k = np.flatnonzero(in_goal_rows(ref.rows, problem.goal_region(0.5)))
     return float(ref.s[k[0]]) if len(k) else math.inf
 
 
@@ -222,6 +214,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     rng = np.random.default_rng(s.seed)
     fixed = s.fixed_latency_ms / 1000.0 if s.fixed_latency_ms is not None else None
     uncertainty = s.uncertainty(scenario)
+    goal = problem.goal_region()
     def new_replanner() -> Replanner:
         # No polishing: a cycle's budget is a few milliseconds, and the next cycle replans.
         return Replanner(problem, PlanOptions(seed=s.seed, polish=False, timing=s.timing,
@@ -356,7 +349,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
         v, steer = v_cmd, steer_cmd
         if counter is not None:
             counter.update(t, x, y)
-        if (counter.laps >= s.laps) if counter is not None else _in_goal(problem, x, y, th):
+        if (counter.laps >= s.laps) if counter is not None else in_goal(x, y, th, goal):
             reached = True
             break
         if fsm is not None and fsm.done(v):  # the machine's Stop reached, at rest
