@@ -18,7 +18,9 @@ START_TIMEOUT_S = 60  # cold worker start on a loaded 2-core runner; normally ~2
 
 class Server:
     def __init__(self, data_dir: Path, *args: str, env: dict | None = None,
-                 command: list[str] | None = None) -> None:
+                 command: list[str] | None = None, warm: bool = True) -> None:
+        """``warm``: wait until /health says the kernels are loaded (the server answers before:
+        it loads them in the background)."""
         cmd = command or ["trackstar", "serve", "--port", "0", "--ui-port", "0",
                           "--data-dir", str(data_dir), *args]
         self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
@@ -47,6 +49,12 @@ class Server:
         self.url = f"http://127.0.0.1:{self.port}"
         self.client = httpx.Client(base_url=self.url + "/api/v1", timeout=60)
         self.root = httpx.Client(base_url=self.url, timeout=60)
+        deadline = time.monotonic() + START_TIMEOUT_S
+        while warm and self.get("/health").json()["status"] != "ok":
+            if time.monotonic() > deadline:
+                self.stop()
+                raise RuntimeError(f"the kernels did not load: {self.err}")
+            time.sleep(0.05)
 
     def get(self, path: str, **kw) -> httpx.Response:
         return self.root.get(path, **kw)

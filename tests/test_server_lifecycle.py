@@ -203,3 +203,21 @@ def test_a_simulation_past_the_wall_time_cap_is_stopped_and_says_why(tmp_path):
         assert srv.workers_cpu_s() - busy < 0.05, "the worker still simulates"
     finally:
         srv.stop()
+
+
+def test_a_first_start_answers_at_once_says_warming_and_stops_promptly(tmp_path):
+    """An empty numba cache, as after an install: the URLs come at once, /health says
+    "warming" while the kernels compile in the background, a plan waits for them rather than
+    failing, and SIGTERM ends the server without waiting for the compile."""
+    started = time.monotonic()
+    srv = Server(tmp_path / "data", env={"NUMBA_CACHE_DIR": str(tmp_path / "cache")},
+                 warm=False)
+    try:
+        took = time.monotonic() - started
+        assert took < 10, f"the URLs came after {took:.1f} s"
+        assert srv.get("/health").json()["status"] == "warming"
+        with pytest.raises(httpx.ReadTimeout):  # waits: neither a failure nor a 5xx
+            srv.client.post("/plan", json={"scenario_id": "slalom", "time": 0.1}, timeout=2)
+        assert srv.get("/health").status_code == 200  # and the server still answers
+    finally:
+        assert srv.stop() < 10

@@ -60,3 +60,15 @@ def test_a_cached_kernel_loads_without_parsing_its_bitcode_or_scanning_for_exten
                          timeout=60, check=True)
     count, missing = out.stdout.split(" ", 1)
     assert int(count) > 100 and missing.strip() == "[]"
+
+
+def test_the_numba_we_pin_is_one_jit_knows_every_patch_applies():
+    """pyproject.toml pins numba below the first version CI has not run; on it, each of
+    planner/_jit.py's patches takes (a numba it does not know would get plain caching)."""
+    from numba.core import codegen, environment
+
+    from planner import _jit
+
+    assert _jit._LOADS_OWN_EXTENSIONS
+    assert environment._rebuild_env.__module__ == "planner._jit"
+    assert codegen.CPUCodeLibrary._get_module_for_linking.__module__ == "planner._jit"

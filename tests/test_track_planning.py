@@ -20,7 +20,8 @@ def test_half_lap_of_the_thesis_track_stays_on_the_track_and_off_the_box():
     dense = densify(result.path[:, [0, 1, 2, 5]], 0.005)
     discs = shapely.buffer(shapely.points(dense[:, :2]), radius)
     assert shapely.contains(region, discs).all()
-    box = shapely.box(0.434, -1.942, 0.534, -1.642)
+    (cx, cy), (length, width) = data["obstacles"][0]["center"], data["obstacles"][0]["size"]
+    box = shapely.box(cx - length / 2, cy - width / 2, cx + length / 2, cy + width / 2)
     assert not shapely.intersects(box, discs).any()
     # The goal is half a lap ahead: the path follows the track, it does not cut across.
     assert 6.0 < result.cost < 7.5

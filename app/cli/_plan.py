@@ -11,7 +11,7 @@ import typer
 
 from app.cli._errors import user_errors
 from app.cli._options import model_options
-from app.cli._warm import warm_kernels
+from app.kernels import warm_kernels
 from planner.options import PlanOptions
 
 scenario_cli = typer.Typer(help="Scenarios: the bundled ones, validation and the schema.",

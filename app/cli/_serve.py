@@ -19,7 +19,6 @@ from urllib.parse import quote
 import typer
 
 from app.cli._errors import InputError, user_errors
-from app.cli._warm import warm_kernels
 
 if TYPE_CHECKING:
     from app.access import Access
@@ -143,7 +142,9 @@ def serve(
         if not _is_loopback(host) and access.token is None:
             print(f"warning: listening on {host} without --token: whoever reaches it may use "
                   "it (docs/server.md: a shared server)", file=sys.stderr, flush=True)
-        warm_kernels()  # before the studio and the workers need them: a first start compiles
+        from app.kernels import warm_in_background
+
+        warm_in_background()  # answer at once; a first start after an install compiles them
         # uvicorn re-raises the stop signal once it has shut down; we have already stopped.
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, lambda *_: None)

@@ -11,7 +11,7 @@ import typer
 
 from app.cli._errors import user_errors
 from app.cli._plan import ScenarioArg
-from app.cli._warm import warm_kernels
+from app.kernels import warm_kernels
 
 
 def simulate(

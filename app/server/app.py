@@ -166,7 +166,8 @@ def create_app(settings: ServerSettings) -> FastAPI:
 
     @app.get("/health", response_model=Health, tags=["server"])
     def health() -> Health:
-        return Health(status="ok", version=app.version, ui_port=settings.ui_port)
+        return Health(status="ok" if app.state.planning.started else "warming",
+                      version=app.version, ui_port=settings.ui_port)
 
     @app.get("/", include_in_schema=False)
     def landing() -> FileResponse:

@@ -1,7 +1,8 @@
 """Planning off the event loop: one process pool for single plans and batch jobs.
 
-The pool is sized to the machine and started with the server; each worker loads the planner's
-compiled kernels once (`warm_up` as its initializer), so no request pays for it. A job feeds
+The pool is sized to the machine and started as soon as the server's kernels are loaded
+(`app.kernels`; requests wait until then); each worker loads the planner's compiled kernels once
+(`warm_up` as its initializer), so no request pays for it. A job feeds
 the pool at most one run per worker at a time, so a single POST /plan waits for one run, not
 for a whole batch. At shutdown the workers are terminated (a plan may have up to --max-plan-s
 left) and unfinished jobs are marked failed, so a restart shows what was interrupted.
@@ -27,6 +28,7 @@ from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
+from app import kernels
 from app.planning import TrackSource, check_scenario, run_plan
 from app.pool import StopFlag, first_line, machine_workers, start_pool, stop_pool
 from app.server.store import Store
@@ -69,7 +71,11 @@ class Planning:
         self.max_plan_s = max_plan_s
         self.max_sim_s = max_sim_s  # wall time a simulation may keep a worker busy
         self.workers = workers or machine_workers()
-        self.pool = self._start_pool()
+        # Started once the kernels are loaded (`app.kernels`): the workers then load them from
+        # numba's cache instead of each compiling them beside the server on a first start.
+        self.pool: ProcessPoolExecutor | None = None
+        self._pool_started = asyncio.Event()
+        self._opening = asyncio.create_task(self._open_pool())
         self._jobs: dict[str, asyncio.Task] = {}  # batch jobs and simulations
         self.sim_dir = store.path.parent / "simulations"  # per-run log CSV and progress files
         self.sim_dir.mkdir(exist_ok=True)
@@ -82,12 +88,25 @@ class Planning:
     def _start_pool(self) -> ProcessPoolExecutor:
         return start_pool(self.workers)
 
+    @property
+    def started(self) -> bool:
+        """Whether the kernels are loaded and the workers started (/health: "ok")."""
+        return self._pool_started.is_set()
+
+    async def _open_pool(self) -> None:
+        kernels.warm_in_background()  # `trackstar serve` has started it; an app served otherwise
+        while not kernels.ready():  # polled, not awaited in a thread: a stop must not wait
+            await asyncio.sleep(0.05)
+        self.pool = self._start_pool()
+        self._pool_started.set()
+
     def _flag(self) -> StopFlag:
         return StopFlag(self.stop_dir / uuid.uuid4().hex)
 
     async def _call(self, fn, *args, **kwargs):
         """``fn(*args, **kwargs)`` in a worker; a ``stop`` keyword is the call's StopFlag."""
         call = functools.partial(fn, *args, **kwargs)
+        await self._pool_started.wait()  # plans wait for the kernels, they do not fail
         pool = self.pool
         try:
             return await _submit(pool, call)
@@ -252,7 +271,9 @@ class Planning:
         for task in list(self._jobs.values()):
             task.cancel()
         await asyncio.gather(*self._jobs.values(), return_exceptions=True)
-        await asyncio.to_thread(stop_pool, self.pool)
+        self._opening.cancel()
+        if self.pool is not None:
+            await asyncio.to_thread(stop_pool, self.pool)
 
 
 async def _submit(pool: ProcessPoolExecutor, call: functools.partial):

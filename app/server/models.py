@@ -68,7 +68,10 @@ class _Body(KnownKeys):
 
 
 class Health(BaseModel):
-    status: Literal["ok"]
+    status: Literal["ok", "warming"] = Field(
+        description="warming: the planner's kernels are still loading (the first start after "
+                    "an install compiles them, about a minute) or its workers starting; plans "
+                    "wait for them")
     version: str
     ui_port: int | None
 

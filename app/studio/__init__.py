@@ -11,9 +11,13 @@ from dataclasses import dataclass, field
 
 import viser
 
+from app import kernels
 from app.access import Access
 
 __all__ = ["StudioHandle", "launch"]
+
+PREPARING = ("**Preparing the planner** (the first start after an install compiles it: about a "
+             "minute) …")
 
 
 @dataclass
@@ -36,9 +40,7 @@ def launch(host: str, port: int, api_url: str, access: Access | None = None) -> 
     browsers may connect (default: loopback names and ``host``, no token)."""
     from app.studio._gate import Gate
     from app.studio._session import Session
-    from planner.timing import warm_up
 
-    warm_up()  # compiled kernels from numba's cache, before the first tab waits for them
     server = viser.ViserServer(host=host, port=port, verbose=False)
     server.gui.configure_theme(control_width="large", show_share_button=False)
     server.scene.world_axes.visible = False
@@ -51,6 +53,10 @@ def launch(host: str, port: int, api_url: str, access: Access | None = None) -> 
         was built, `_disconnect` found nothing to close, so the session closes itself here
         (else its threads would run, and hold it, forever). viser drops a client from
         `get_clients` before it calls `_disconnect`, so exactly one of the two closes it."""
+        if not kernels.ready():  # the server has just started: it loads them in the background
+            note = client.gui.add_markdown(PREPARING)
+            kernels.wait()
+            note.remove()
         session = Session(client, api_url)
         with lock:
             if client.client_id in server.get_clients():
