@@ -1,7 +1,9 @@
 # Trackstar: REST API (8000) and browser studio (8080) in one process.
-#   docker build -t trackstar . && docker run -p 8000:8000 -p 8080:8080 -v trackstar:/data trackstar
-# It binds 0.0.0.0, so it answers to localhost and 127.0.0.1 only; for a shared server pass the
-# names users type and a token (docs/server.md, "A shared server"):
+#   docker build -t trackstar .
+#   docker run -p 127.0.0.1:8000:8000 -p 127.0.0.1:8080:8080 -v trackstar:/data trackstar
+# It listens on 0.0.0.0 in the container, so it generates a token at each start and prints it with
+# the studio's sign-in URL (docker logs). For a shared server pass the names users type and a
+# token of your choice (docs/server.md, "A shared server"):
 #   -e TRACKSTAR_ALLOWED_HOSTS=lab-pc.example.edu -e TRACKSTAR_TOKEN=…
 FROM python:3.11-slim
 

@@ -123,12 +123,36 @@ def test_the_dockerfile_cmd_serves_health(tmp_path):
                                              "TRACKSTAR_UI_PORT": str(ui_port),
                                              "TRACKSTAR_DATA_DIR": str(tmp_path)})
     try:
-        assert srv.lines[-1] == f"UI: http://0.0.0.0:{ui_port}/"
-        assert any("without --token" in line for line in srv.err)
+        assert f"UI: http://0.0.0.0:{ui_port}/" in srv.lines
+        # Beyond loopback without a token: one is generated and printed, as Jupyter does.
+        token = next(line.split()[1] for line in srv.lines if line.startswith("Token: "))
+        assert len(token) >= 32
+        assert f"Studio with the token: http://0.0.0.0:{port}/studio?token={token}" in srv.lines
         health = srv.get("/health").json()
         assert health["status"] == "ok" and health["ui_port"] == ui_port
+        for host in ("localhost", "127.0.0.1", f"127.0.0.1:{port}"):  # no name gets past it
+            refused = srv.client.get("/scenarios", headers={"Host": host})
+            assert refused.status_code == 401, (host, refused.text)
+            refused = srv.client.post("/plan", json={"scenario_id": "slalom", "time": 0.1},
+                                      headers={"Host": host})
+            assert refused.status_code == 401, (host, refused.text)
+        signed = {"Authorization": f"Bearer {token}"}
+        assert srv.client.get("/scenarios", headers=signed).status_code == 200
     finally:
         assert srv.stop() < 5
+
+
+def test_no_token_beyond_loopback_is_an_explicit_choice_with_a_warning(tmp_path):
+    srv = Server(tmp_path, "--host", "0.0.0.0", "--no-token")
+    try:
+        assert not any(line.startswith("Token: ") for line in srv.lines)
+        assert any("with --no-token: whoever reaches it may use it" in line for line in srv.err)
+        assert srv.client.get("/scenarios").status_code == 200
+    finally:
+        srv.stop()
+    both = subprocess.run(["trackstar", "serve", "--token", "t0k3n", "--no-token"],
+                          capture_output=True, text=True, timeout=60)
+    assert both.returncode == 2 and "choose one of --token and --no-token" in both.stderr
 
 
 def pool_workers(srv) -> list[int]:

@@ -421,3 +421,27 @@ def test_a_terminal_gets_a_progress_bar_even_one_that_reports_no_size(tmp_path):
         assert run.wait(timeout=120) == 0
         assert b"2/2 [" in drawn and b"run/s" in drawn, (rows, cols, drawn)
         assert b"study tiny: 2 of 2 runs done" in run.stdout.read()
+
+
+def test_the_median_cost_curve_counts_unsolved_seeds_and_never_rises():
+    """The case a reader saw as a best cost getting worse: seeds solved late with a worse cost.
+    Over all seeds (an unsolved one counting as infinite) the median is drawn once more than
+    half are solved, and from there it only falls."""
+    from app.study.report import Setting, _curve
+
+    db = sqlite3.connect(":memory:")
+    db.execute("CREATE TABLE cost_over_time (run_id INTEGER, iteration INTEGER, t_s REAL, "
+               "cost REAL)")
+    improvements = {1: [(100, 26.6), (900, 26.0)], 2: [(400, 28.1), (950, 27.0)],
+                    3: [(700, 29.5)], 4: []}  # seed 4 never solves
+    for run, points in improvements.items():
+        db.executemany("INSERT INTO cost_over_time VALUES (?, ?, 0, ?)",
+                       [(run, it, cost) for it, cost in points])
+    setting = Setting("rrt", [{"id": run} for run in improvements])
+    grid = np.arange(0, 1001, 50.0)
+    low, mid, high = _curve(db, setting, False, grid)
+    drawn = np.isfinite(mid)
+    assert not drawn[grid < 700].any() and drawn[grid >= 700].all()  # 3 of 4 solved at 700
+    assert np.all(np.diff(mid[drawn]) <= 0)  # the old, per-solved-seed median went 26.6 → 29.5
+    assert mid[grid == 700][0] == 29.5 and mid[-1] == 29.5
+    assert np.isnan(high).all() and np.isfinite(low[grid >= 400]).all()

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ipaddress
 import os
+import secrets
 import signal
 import socket
 import sys
@@ -54,7 +55,8 @@ def _api_url(host: str, port: int, access: Access) -> str:
     return f"http://{login}{name}:{port}/api/v1"
 
 
-async def _run(app, api: socket.socket, host: str, ui: socket.socket) -> None:
+async def _run(app, api: socket.socket, host: str, ui: socket.socket, generated: bool) -> None:
+    """Serve until stopped; ``generated``: the token is this start's own, so it is printed."""
     import asyncio  # here, not at the top: every other command would pay its 20 ms
 
     import uvicorn
@@ -77,8 +79,12 @@ async def _run(app, api: socket.socket, host: str, ui: socket.socket) -> None:
         if server.started:
             print(f"API: http://{host}:{api_port}/docs", flush=True)
             print(f"UI: http://{host}:{ui_port}/", flush=True)
+            if generated:
+                print(f"Token: {access.token} (generated; choose one with TRACKSTAR_TOKEN, or "
+                      f"serve without one with --no-token)", flush=True)
             if access.token:
-                print(f"Studio with the token: http://{host}:{api_port}/studio?token=<token>",
+                shown = quote(access.token, safe="") if generated else "<token>"
+                print(f"Studio with the token: http://{host}:{api_port}/studio?token={shown}",
                       flush=True)
         await serving
     finally:
@@ -112,6 +118,11 @@ def serve(
         envvar="TRACKSTAR_ALLOW_ORIGIN", show_default=False,
         help="A web origin (https://site.org) allowed to change data and open the studio, "
              "besides the server's own; repeatable.")] = None,
+    no_token: Annotated[bool, typer.Option(
+        "--no-token", envvar="TRACKSTAR_NO_TOKEN",
+        help="Listening beyond loopback, serve without a token: whoever reaches the port may "
+             "use it. Otherwise a --host other than loopback without --token gets a generated "
+             "token, printed with the studio's sign-in URL (as Jupyter does).")] = False,
 ) -> None:
     """Serve the REST API (/docs) and the browser studio; Ctrl-C stops both."""
     import platformdirs
@@ -122,6 +133,11 @@ def serve(
     with user_errors():
         if token is not None and (not token.isprintable() or token.strip() != token or not token):
             raise InputError("--token must be printable, without spaces at its ends")
+        if token is not None and no_token:
+            raise InputError("choose one of --token and --no-token")
+        generated = token is None and not no_token and not _is_loopback(host)
+        if generated:  # served beyond this machine: nobody uses it without the token
+            token = secrets.token_urlsafe(24)
         try:
             access = Access.build(host, allowed_hosts or [], allow_origin or [], token)
         except ValueError as exc:
@@ -140,7 +156,7 @@ def serve(
                                   ui_port=ui.getsockname()[1],
                                   access=access)
         if not _is_loopback(host) and access.token is None:
-            print(f"warning: listening on {host} without --token: whoever reaches it may use "
+            print(f"warning: listening on {host} with --no-token: whoever reaches it may use "
                   "it (docs/server.md: a shared server)", file=sys.stderr, flush=True)
         from app.kernels import warm_in_background
 
@@ -150,7 +166,7 @@ def serve(
             signal.signal(sig, lambda *_: None)
         import asyncio
 
-        asyncio.run(_run(create_app(settings), api, host, ui))
+        asyncio.run(_run(create_app(settings), api, host, ui, generated))
 
 
 def register(cli: typer.Typer) -> None:

@@ -108,7 +108,9 @@ def _settings(db: sqlite3.Connection, table: str) -> dict[str, dict[str, Setting
 
 
 def _curve(db: sqlite3.Connection, setting: Setting, by_time: bool, grid: np.ndarray):
-    """Quartiles over seeds of the best cost at each grid point (NaN: not solved yet)."""
+    """Quartiles over all seeds of the best cost at each grid point, as Planner Arena draws
+    them: a seed not solved yet counts as an infinite cost, so a quartile is drawn (not NaN)
+    only once more than that share of the seeds is solved, and the median never rises."""
     column = "t_s" if by_time else "iteration"
     curves = []
     for row in setting.rows:
@@ -117,11 +119,12 @@ def _curve(db: sqlite3.Connection, setting: Setting, by_time: bool, grid: np.nda
         x = np.array([p[0] for p in pts], dtype=float)
         c = np.array([p[1] for p in pts], dtype=float)
         k = np.searchsorted(x, grid, side="right") - 1
-        curves.append(np.where(k >= 0, c[np.maximum(k, 0)] if len(c) else np.nan, np.nan))
+        curves.append(np.where(k >= 0, c[np.maximum(k, 0)] if len(c) else np.inf, np.inf))
     stack = np.array(curves)
-    with warnings.catch_warnings():  # before the first solution a column is all NaN
+    with warnings.catch_warnings():  # a quantile between a cost and infinity
         warnings.simplefilter("ignore", RuntimeWarning)
-        return [np.nanpercentile(stack, q, axis=0) for q in (25, 50, 75)]
+        quartiles = [np.percentile(stack, q, axis=0, method="higher") for q in (25, 50, 75)]
+    return [np.where(np.isfinite(q), q, np.nan) for q in quartiles]
 
 
 def _figures(db, kind: Kind, settings: dict[str, Setting]):
@@ -132,8 +135,9 @@ def _figures(db, kind: Kind, settings: dict[str, Setting]):
     height = 1.2 + 0.32 * len(labels)
     fig = Figure(figsize=(8, height), layout="constrained")
     ax = fig.subplots()
-    ax.barh(labels, [100 * settings[k].rate(kind.success) for k in labels], color="C2")
-    ax.set(xlim=(0, 100), xlabel=f"{kind.success_label} (%)")
+    bars = ax.barh(labels, [100 * settings[k].rate(kind.success) for k in labels], color="C2")
+    ax.bar_label(bars, fmt="%.0f", padding=3)  # a 0 % bar has no width: its label shows it
+    ax.set(xlim=(0, 108), xlabel=f"{kind.success_label} (%)")
     ax.invert_yaxis()
     yield "success", f"Success: {kind.success_label}", fig
     for column, title in kind.boxes:
@@ -171,9 +175,11 @@ def _cost_over_time(db, settings: dict[str, Setting]):
         ax.plot(grid, mid, color=f"C{i}", label=setting.label)
         ax.fill_between(grid, low, high, color=f"C{i}", alpha=0.12)
     ax.set_xlabel("time (s)" if by_time else "iterations")
-    ax.set_ylabel("best cost (m; timing optimal: s): median,\nquartiles over the seeds solved so far")
+    ax.set_ylabel("best cost (m; timing optimal: s)")
     fig.legend(loc="outside lower center", fontsize="small")
-    title = "Cost over " + ("time" if by_time else "iterations")
+    title = ("Cost over " + ("time" if by_time else "iterations") + ": median and quartiles "
+             "over all seeds, a seed not solved yet counting as infinite (so a line starts once "
+             "more than half are solved)")
     if len(candidates) > len(shown):
         title += f": the best {len(shown)} of {len(candidates)} settings"
     return "cost_over_time", title, fig
