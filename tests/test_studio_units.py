@@ -13,7 +13,7 @@ import pytest
 import planner
 from app.studio._custom import Draft, custom_scenario
 from app.studio._edit import moved_obstacle, parse_waypoints
-from app.studio._extend import LINES, StepInfo, explain, render
+from app.studio._extend import RRT_LINES, STAR_LINES, StepInfo, explain, render
 from app.studio._panel import STEERINGS
 from app.studio._scenario import default_scenario
 from app.studio._tree import EdgeChunks
@@ -116,13 +116,18 @@ def test_extend_explains_what_each_iteration_really_did():
             assert run.snapshot().parent[info.new] == info.parent
     assert {6, 7} <= seen  # nodes were added, with and without rewires
     html = render(7, "a <note>")
-    assert html.count("<mark>") == 1 and LINES[7].split(":")[0] in html
+    assert html.count("<mark>") == 1 and STAR_LINES[7].split(":")[0] in html
     assert "&lt;note&gt;" in html
 
 
-def test_rrt_without_star_ends_on_the_insert_line():
+def test_rrt_shows_its_own_pseudocode_and_ends_on_its_insert_line():
+    """RRT never runs Near, argmin or Rewire: its panel does not show them."""
     info = StepInfo(iteration=1, nearest=0, new=1, parent=0, n_near=0, n_rewired=0, radius=0.0)
-    assert explain(info, star=False)[0] == 6
+    line, _ = explain(info, star=False)
+    assert RRT_LINES[line].strip() == "T.add(x_new, parent = x_nearest)"
+    html = render(line, star=False)
+    assert "Rewire" not in html and "Near(" not in html and "argmin" not in html
+    assert "Rewire" in render(None) and "Near(" in render(None)
 
 
 def _draft(points) -> Draft:
@@ -216,6 +221,11 @@ def test_timing_optimal_shows_the_schedule_and_drive_car_stands_still_through_it
     assert m["waited_s"] > 10.0 and m["arrival_s"] == pytest.approx(path[-1, 5])
     assert f"| arrives after | {m['arrival_s']:.3g} s (waits {m['waited_s']:.3g} s) |" in (
         _metrics_md(m))
+    # When it came, in the planner's own terms (a paced run takes longer to watch).
+    first = m["first_solution_iteration"]
+    assert 0 < first <= 1500 and (f"| first solution | iteration {first:,} "
+                                  f"({m['time_to_first_solution_s']:.3g} s of planning) |"
+                                  ) in _metrics_md(m)
     still = np.flatnonzero(np.all(np.diff(path[:, :3], axis=0) == 0.0, axis=1))  # i to i + 1
     assert np.diff(path[:, 5])[still].sum() == pytest.approx(m["waited_s"])
     for i in still:

@@ -1,4 +1,5 @@
-"""The teaching view's text: RRT*'s EXTEND with the line one iteration ended on highlighted.
+"""The teaching view's text: EXTEND with the line one iteration ended on highlighted, RRT*'s or
+RRT's (which has no Near, argmin or Rewire to show).
 
 The line is chosen from the kernel's event record of that iteration, so the panel explains what
 the planner really did (rejected sample, blocked steer, new node, rewires), not a replay.
@@ -12,13 +13,17 @@ from dataclasses import dataclass
 
 import planner
 
-__all__ = ["FIRST_NOTE", "LINES", "StepInfo", "explain", "near_note", "render", "until_note"]
+__all__ = ["FIRST_NOTE", "StepInfo", "explain", "lines", "near_note", "render", "until_note"]
 
-LINES = (
+_GROW = (
     "x_rand ← SampleFree()",
     "x_nearest ← Nearest(T, x_rand)",
     "x_new ← Steer(x_nearest, x_rand)   ▹ at most ε",
     "if ObstacleFree(x_nearest, x_new):",
+)
+RRT_LINES = (*_GROW, "    T.add(x_new, parent = x_nearest)", "return T")
+STAR_LINES = (
+    *_GROW,
     "    X_near ← Near(T, x_new, r)",
     "    x_min ← argmin Cost(x) + c(x, x_new) over free x ∈ X_near",
     "    T.add(x_new, parent = x_min)",
@@ -47,14 +52,19 @@ class StepInfo:
                    len(ev.near_of(i)), n_rewired, float(ev.radius[i]))
 
 
+def lines(star: bool) -> tuple[str, ...]:
+    """The pseudocode of RRT* (``star``) or of RRT."""
+    return STAR_LINES if star else RRT_LINES
+
+
 def explain(info: StepInfo, star: bool) -> tuple[int, str]:
-    """(index into LINES of the line the iteration ended on, a one-line explanation)."""
+    """(index into `lines` of the line the iteration ended on, a one-line explanation)."""
     if info.nearest < 0:
         return 0, "x_rand fell inside an obstacle: SampleFree rejects it (the iteration counts)."
     if info.new < 0:
         return 3, f"The path from x_nearest (#{info.nearest}) to x_new is blocked: no node added."
     if not star:
-        return 6, f"x_new (#{info.new}) added with parent x_nearest (#{info.parent})."
+        return 4, f"x_new (#{info.new}) added with parent x_nearest (#{info.parent})."
     if info.n_rewired:
         return 7, (f"x_new (#{info.new}) joined via x_min (#{info.parent}); {info.n_rewired} of "
                    f"{info.n_near} near nodes got cheaper through it and were rewired.")
@@ -93,11 +103,11 @@ def until_note(until: str | None, count: int, outcome: str) -> str:
             f"stopped ({why}).")
 
 
-def render(line: int | None, *notes: str) -> str:
-    """The panel's HTML: numbered pseudocode, the current line in a <mark>, the notes below
-    (empty ones left out)."""
+def render(line: int | None, *notes: str, star: bool = True) -> str:
+    """The panel's HTML: numbered pseudocode (RRT*'s, or RRT's), the current line in a <mark>,
+    the notes below (empty ones left out)."""
     rows = []
-    for i, text in enumerate(LINES):
+    for i, text in enumerate(lines(star)):
         code = f"{i + 1:>2}  {html.escape(text)}"
         rows.append(f"<mark>{code}</mark>" if i == line else code)
     return ("<pre style='font-size:11px;line-height:1.5;margin:0;white-space:pre-wrap'>"

@@ -150,18 +150,18 @@ class Profiles:
             kappa, (_series("s (m)"), _series("centreline κ", "#4a90e2"),
                     _series("path κ", CURRENT, 2.0), _series("+κmax", "#2e9e5b", 1, [4, 4]),
                     _series("−κmax", "#2e9e5b", 1, [4, 4]), *_reverse_series(self._kmax)),
-            title="Curvature κ (1/m) vs s", **common)
+            title="Curvature κ (1/m) vs s (m)", **common)
         self.steering = gui.add_uplot(
             steer, (_series("s (m)"), _series("centreline δ", "#4a90e2"),
                     _series("path δ", CURRENT, 2.0), _series("+δmax", "#2e9e5b", 1, [4, 4]),
                     _series("−δmax", "#2e9e5b", 1, [4, 4]), *_reverse_series(self._dmax)),
-            title="Steering δ (deg) vs s", **common)
+            title="Steering δ (deg) vs s (m)", **common)
         self.speed = gui.add_uplot(
             speed, (_series("s (m)"), _series("path v", CURRENT, 2.0),
                     _series(f"limit (v ≤ {limits.v_max:g}, a_lat ≤ {limits.a_lat:g}, "
                             f"|a_long| ≤ {limits.a_long:g})", "#2e9e5b", 1, [4, 4]),
                     _series("v = 0")),
-            title="Fastest speed v (m/s) vs s",
+            title="Fastest speed v (m/s) vs s (m)",
             **common | {"bands": ({"series": (2, 3), "fill": "rgba(80,200,120,0.12)"},)})
         self.cost = gui.add_uplot(
             (np.array([0.0, 1.0]), np.array([math.nan, math.nan])),

@@ -187,6 +187,8 @@ class Lane:
         tree, wall = self.tree, self.wall
         out = {"iterations": tree.iterations, "nodes": tree.nodes, "rewires": tree.rewires,
                "time_to_first_solution_s": tree.time_to_first_solution_s,
+               "first_solution_iteration": next(
+                   (it for _, _, it in tree.cost_over_time), None),
                "cost": tree.best_cost,
                "iterations_per_s": tree.iterations / wall if wall > 0 else 0.0,
                "planning_time_s": tree.planning_time_s}
