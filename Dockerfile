@@ -20,6 +20,7 @@ COPY app ./app
 COPY planner ./planner
 COPY tracks ./tracks
 COPY static ./static
+COPY examples ./examples
 # Editable, so the app finds static/ beside it.
 RUN pip install -e .
 

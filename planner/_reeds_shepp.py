@@ -39,8 +39,11 @@ from planner._jit import njit
 PI = math.pi
 TWO_PI = 2.0 * math.pi
 HALF_PI = 0.5 * math.pi
-# Acceptance slack on the sign conditions of the base formulas (OMPL's ZERO).
-_ZERO = 10.0 * np.finfo(np.float64).eps
+# Acceptance slack on the sign conditions of the base formulas. OMPL's ZERO, 10 machine
+# epsilons, lost R−S− from (1, 0, 0) to (−0.48, −0.39, 0.5) at ρ = 3 (hypothesis found it): its
+# last arc came out as −2.4e-15 rad, and the next word was 5 % longer. Rounding in atan2 and
+# the wrap of angles up to 2π is a few 1e-15; a segment of −1e-12 rad is none.
+_ZERO = 1e-12
 # Slack on the pruning bounds, so that rounding never prunes a word that would have won.
 _SLACK = 1e-9
 

@@ -299,3 +299,12 @@ def test_bounded_length_is_exact_below_the_bound_and_above_it_otherwise(p, q, rh
         assert got > bound
     # a bound equal to the length itself still yields the exact length
     assert length(p, q, rho, exact) == pytest.approx(exact, rel=1e-12, abs=1e-12)
+
+
+def test_a_vanishing_last_arc_is_not_lost_to_rounding():
+    """R− S− of 0.05078125 m at ρ = 3: its degenerate third arc rounds to −2.4e-15 rad, which
+    OMPL's slack of 10 machine epsilons refused, and a word 5 % longer won (hypothesis)."""
+    start, rho = (1.0, 0.0, 0.0), 3.0
+    kinds, lens = np.array([-1, 0, 0, 0, 0], np.int8), np.array([-1.5, -0.05078125, 0, 0, 0])
+    goal = path_end(*start, kinds, lens, rho)
+    assert length(start, goal, rho) == pytest.approx(1.55078125, abs=1e-9)

@@ -155,6 +155,16 @@ def test_no_token_beyond_loopback_is_an_explicit_choice_with_a_warning(tmp_path)
     assert both.returncode == 2 and "choose one of --token and --no-token" in both.stderr
 
 
+def test_the_image_holds_what_the_readmes_commands_name():
+    """A `trackstar` command in the README that names a file of the repository
+    (examples/fsm/hallway.json) works in the image too: the Dockerfile copies its directory."""
+    commands = re.findall(r"^trackstar .*$", (ROOT / "README.md").read_text(), re.MULTILINE)
+    copied = set(re.findall(r"^COPY (\S+) \./", (ROOT / "Dockerfile").read_text(), re.MULTILINE))
+    named = {word.split("/")[0] for line in commands for word in line.split()
+             if "/" in word and (ROOT / word).is_file()}
+    assert named and named <= copied, named - copied
+
+
 def pool_workers(srv) -> list[int]:
     """The server's worker processes, oldest first."""
     children = Path(f"/proc/{srv.proc.pid}/task/{srv.proc.pid}/children").read_text().split()

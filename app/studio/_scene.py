@@ -22,8 +22,10 @@ __all__ = ["CURVATURE_RGB", "CUSP_UNDER_RGB", "DRAFT_RGB", "GOAL_RGB", "MOVER_RG
            "wxyz_yaw", "yaw_wxyz"]
 
 # Obstacles above the tree: edges pass where a moving obstacle is at other times.
+# A mover lies just above the static obstacles: over one, at the same height, the two would
+# take turns at each pixel (z-fighting: stripes).
 Z = {"surface": -0.02, "centre": 0.002, "tree": 0.006, "flash": 0.008, "obstacle": 0.009,
-     "pin": 0.0095, "path": 0.01, "step": 0.012, "pose": 0.014, "car": 0.016}
+     "mover": 0.0093, "pin": 0.0095, "path": 0.01, "step": 0.012, "pose": 0.014, "car": 0.016}
 CAR_RGB, CAR_LINE_RGB = (250, 250, 250), (20, 20, 20)
 DISCS_RGB, MARGIN_RGB = (120, 120, 120), (235, 235, 235)  # checked discs, margin's dashes
 DRAFT_RGB = (255, 120, 0)  # what is being clicked: polygon corners, a drawn track
@@ -205,8 +207,9 @@ def draw_obstacles(scene, scenario: planner.Scenario, track, root: str = "") -> 
         pose, local = obstacle_shape(ob)
         frame = scene.add_frame(f"{root}/obstacles/o{i}", show_axes=False, position=(*pose[:2], 0.0),
                                 wxyz=yaw_wxyz(pose[2]))
-        _fill(scene, f"{root}/obstacles/o{i}/shape", [local], Z["obstacle"],
-              MOVER_RGB if ob.motion is not None else OBSTACLE_RGB)
+        moves = ob.motion is not None
+        _fill(scene, f"{root}/obstacles/o{i}/shape", [local], Z["mover" if moves else "obstacle"],
+              MOVER_RGB if moves else OBSTACLE_RGB)
         out.append((frame, pose, motion_table(ob.motion, track)))
     return out
 
