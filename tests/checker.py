@@ -18,24 +18,8 @@ import numpy as np
 
 
 def obstacle_offset(ob: dict, t: float) -> tuple[float, float]:
-    motion = ob.get("motion")
-    if not motion:
-        return 0.0, 0.0
-    if "velocity" in motion:
-        vx, vy = motion["velocity"]
-        return vx * t, vy * t
-    wp = np.asarray(motion["waypoints"], dtype=float)
-    return float(np.interp(t, wp[:, 0], wp[:, 1])), float(np.interp(t, wp[:, 0], wp[:, 2]))
-
-
-def _inside_even_odd(pts: np.ndarray, x: float, y: float) -> bool:
-    inside = False
-    n = len(pts)
-    for i in range(n):
-        (x1, y1), (x2, y2) = pts[i], pts[(i + 1) % n]
-        if (y1 > y) != (y2 > y) and x < x1 + (y - y1) * (x2 - x1) / (y2 - y1):
-            inside = not inside
-    return inside
+    dx, dy = _offsets(ob, np.array([t]))
+    return float(dx[0]), float(dy[0])
 
 
 def _outline(ob: dict) -> np.ndarray:
@@ -137,7 +121,7 @@ def _rectangle_valid(scn: dict, rect, x: float, y: float, theta: float,
         pts = _outline(ob) + [dx, dy]
         # Apart iff the outlines neither cross nor touch and neither shape holds the other
         # (then one point of each decides: the car's corner, the obstacle's first vertex).
-        if (_inside_even_odd(pts, *corners[0])
+        if (_inside(_closed(pts), corners[:1, 0], corners[:1, 1])[0]
                 or _rect_distance(x, y, theta, rect, pts[0, 0], pts[0, 1]) <= 0.0
                 or _segment_distance(edges, np.hstack([pts, np.roll(pts, -1, axis=0)])) <= 0.0):
             return False
