@@ -169,6 +169,9 @@ class Motion(StrictModel):
     waypoints: Annotated[list[tuple[Time, Coordinate, Coordinate]],
                          Field(max_length=MAX_WAYPOINTS)] | None = None
     follow_track: FollowTrack | None = None
+    # The simulated car is told this motion instead of predicting it from sensing: a door,
+    # barrier or train that runs to a timetable (docs/simulation.md, "Known timetables").
+    known: bool = False
 
     @model_validator(mode="after")
     def _exactly_one(self) -> Motion:

@@ -9,13 +9,14 @@ import subprocess
 
 import numpy as np
 import pytest
+from checker import first_collision, pose_valid
+from conftest import scenario_dict
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import planner
-from checker import first_collision, pose_valid
-from conftest import scenario_dict
 from planner._world import build_world, moving_clearance
+from planner.scenario import ScenarioError, parse_scenario
 from planner.sim import SimSettings, simulate
 from planner.sim.metrics import AT_REST, MOVING, contacts
 from planner.sim.predict import Uncertainty, predicted_world
@@ -62,6 +63,32 @@ def test_a_predicted_disc_grows_with_the_look_ahead(tau, accel, error, horizon, 
     look = min(age + tau, horizon)
     expected = abs(10.0 - centre) - 0.5 - (error * look + 0.5 * accel * look ** 2)
     assert moving_clearance(grown, 10.0, 0.0, 0.0, tau) == pytest.approx(expected, abs=1e-9)
+
+
+def test_a_known_timetable_is_kept_exactly():
+    """A mover the car is told about keeps its true motion in planner time, ungrown; the other
+    is predicted from its sensing."""
+    world = build_world((-50, -50, 50, 50), 0.0, [(0.0, 0.0, 0.5, 0), (0.0, 20.0, 0.5, 1)], [],
+                        [("waypoints", np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0],
+                                                 [11.0, 0.0, 2.2]])),
+                         ("velocity", (1.0, 0.0))])
+    sensing = Sensing(10.0, np.array([[0.0, 0.0], [10.0, 0.0]]), np.zeros((2, 2)))
+    believed = predicted_world(world, sensing, 10.0, Uncertainty(), known=[True, False])
+    for tau in (0.0, 0.5, 1.0, 3.0):
+        door_y = 2.2 * min(tau, 1.0)  # where the door truly is at t = 10 + tau
+        assert moving_clearance(believed, 5.0, door_y, 0.0, tau) == pytest.approx(5.0 - 0.5)
+        grown = Uncertainty().growth(tau)  # the other one: at rest where sensed, grown
+        assert moving_clearance(believed, 10.0, 25.0, 0.0, tau) == pytest.approx(
+            5.0 - 0.5 - grown)
+    assert believed.geo[5] >= 2.2  # VMAX_OBS covers the known motion's speed
+
+
+def test_the_scenario_says_which_timetables_are_known():
+    scn = scenario_dict("gate")
+    assert parse_scenario(scn).obstacles[2].motion.known
+    scn["obstacles"][2]["motion"]["known"] = "sometimes"
+    with pytest.raises(ScenarioError, match="known"):
+        parse_scenario(scn)
 
 
 @pytest.mark.parametrize("bad", [{"accel": -1.0}, {"speed_error": math.nan},
@@ -192,6 +219,7 @@ def test_a_stop_in_a_movers_likely_path_ranks_below_leaving_it():
 @pytest.mark.parametrize("name, rate, timing, seed", [
     ("crowd_crossing", 10, "constant", 6),  # braked to rest in a walker's way
     ("crowd_merge", 10, "optimal", 3),  # a goal in the stream: evaded it, never came back
+    ("gate", 10, "optimal", 2),  # the door, sensed at rest, closed at 2.2 m/s on the car
 ])
 def test_runs_that_failed_before(name, rate, timing, seed):
     run = simulate(planner.load_scenario(name),

@@ -9,6 +9,7 @@ import time
 import numpy as np
 import pytest
 import viser
+from conftest import scenario_dict
 
 import planner
 from app.studio._clock import SceneClock
@@ -61,13 +62,17 @@ def test_the_view_draws_the_frame_it_received(view):
 
 
 def test_a_collision_and_a_stall_are_marked_where_and_when_with_their_cause(view):
-    """A blind run into the lane's stopped car collides; in the gate scene the car, believing
-    the door shut for good, finds no path and stands: each gets a disc and a label."""
-    for name, kind, cause in (("stop_in_lane", "collision", "clearance"),
-                              ("gate", "stall", "no path found")):
+    """A blind run into the lane's stopped car collides; in the gate scene with the door's
+    timetable unknown, the car, believing the door shut for good, finds no path and stands:
+    each gets a disc and a label."""
+    gate = scenario_dict("gate")
+    gate["obstacles"][2]["motion"]["known"] = False
+    for scenario, kind, cause in ((planner.load_scenario("stop_in_lane"), "collision",
+                                   "clearance"),
+                                  (planner.parse_scenario(gate), "stall", "no path found")):
         settings = dataclasses.replace(view.settings(), realtime=False, duration=12.0,
-                                       replan=name != "stop_in_lane")
-        view.start(planner.compile_problem(planner.load_scenario(name)), settings)
+                                       replan=scenario.name != "stop_in_lane")
+        view.start(planner.compile_problem(scenario), settings)
         run = view.run
         deadline = time.monotonic() + 60
         while run.running and time.monotonic() < deadline:
@@ -80,3 +85,8 @@ def test_a_collision_and_a_stall_are_marked_where_and_when_with_their_cause(view
         k = run.events.index(events[0])
         assert np.allclose(view._handles[f"event{k}"].position[:2], (x, y))
         assert view._handles[f"event{k}/label"].text.startswith(f"{kind} at t = {t:.1f} s")
+    # The door's belief is drawn while the car predicts it, not once it is told the timetable.
+    assert "ghost2" in view._handles and "grown2_0" in view._handles
+    view.start(planner.compile_problem(planner.load_scenario("gate")), settings)
+    assert "ghost2" not in view._handles and "grown2_0" not in view._handles
+    view.stop()

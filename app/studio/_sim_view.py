@@ -7,7 +7,8 @@ calls `SimView.tick`, which draws the latest state: the car; the movers where th
 (the stage's own obstacles, the scene clock set to the simulation's time); where the car
 believes they are (translucent ghosts: the last sensing extrapolated at constant velocity, with
 a line to where it predicts them ``PREDICT_S`` later) and their grown predictions (issue 30:
-the shape grown by the run's uncertainty at look-aheads ``LOOK_AHEAD_S``, fading with τ); the
+the shape grown by the run's uncertainty at look-aheads ``LOOK_AHEAD_S``, fading with τ; none
+for a mover whose timetable the car is told, `motion.known`); the
 committed path, the tree, Soll/Ist steering and lateral error plots, a safety timeline (speed,
 what the guard has the car do, contacts) and the metrics. The scene marks where the car braked,
 waited, evaded or backed off, and each collision with whose it was.
@@ -40,7 +41,7 @@ from app.studio._scene import (
 from planner.sim import SimSettings
 from planner.sim.control import CONTROLLERS
 from planner.sim.run import GUARD_CODES, Frame, simulate
-from planner.sim.sensing import mover_index
+from planner.sim.sensing import known_motions, mover_index
 from planner.validation import describe
 
 __all__ = ["SimControls", "SimView", "build_controls"]
@@ -271,9 +272,10 @@ class SimView:
         self._handles["car"] = draw_car(scene, "/sim/car", scn.vehicle,
                                         marker_size(problem.bounds), scn.start)
         self._movers = mover_index(scn)
+        known = known_motions(scn)  # the car is told these: no belief of its own to draw
         self._centres.clear()
         for i, ob in enumerate(scn.obstacles):
-            if self._movers[i] < 0:
+            if self._movers[i] < 0 or known[self._movers[i]]:
                 continue
             (x, y, yaw), local = obstacle_shape(ob)  # offsets move the declared pose
             self._centres[i] = np.array([x, y])

@@ -13,6 +13,9 @@ at a (the `Uncertainty`): the set where it can be is its shape grown by that muc
 held beyond the horizon T, so far look-aheads do not close every lane; the car re-checks what it
 commits to every cycle (`planner.sim.guard`). ``geo[VMAX_OBS]`` is kept at the fastest predicted
 speed plus the fastest growth, since the exact motion checks rely on it.
+
+A mover whose timetable the car is told (`motion.known`: a door, a barrier, a train) keeps its
+true motion, shifted into planner time, with no growth.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._world import VMAX_OBS, WAYPOINTS, World
+from planner._world import VELOCITY, VMAX_OBS, WAYPOINTS, World
 from planner.sim.sensing import Sensing
 
 __all__ = ["HORIZON_S", "Uncertainty", "predicted_world"]
@@ -57,22 +60,36 @@ class Uncertainty:
 
 
 def predicted_world(base: World, sensing: Sensing, t0: float,
-                    uncertainty: Uncertainty = Uncertainty()) -> World:
+                    uncertainty: Uncertainty = Uncertainty(), known=None) -> World:
     """``base`` with its movers replaced by the grown constant-velocity prediction from
-    ``sensing``, in a planner time that starts at absolute time ``t0``."""
+    ``sensing``, in a planner time that starts at absolute time ``t0``; the movers where the
+    boolean ``known`` (per motion, world order) is true keep their true motion."""
     n = sensing.offsets.shape[0]
     if n == 0:
         return base
+    known = np.zeros(n, bool) if known is None else np.asarray(known, bool)
     start = sensing.offsets + sensing.velocities * (t0 - sensing.t)
-    end = start + sensing.velocities * HORIZON_S
-    wp = np.empty((2 * n, 3))
-    wp[0::2, 0], wp[0::2, 1:] = 0.0, start
-    wp[1::2, 0], wp[1::2, 1:] = HORIZON_S, end
-    grow = np.empty((n, 5))
-    grow[:] = (0.0, uncertainty.speed_error, uncertainty.accel, t0 - sensing.t,
-               uncertainty.horizon)
+    wps = [_timetable(base, m, t0) if known[m] else
+           np.array([[0.0, *start[m]], [HORIZON_S, *(start[m] + sensing.velocities[m] * HORIZON_S)]])
+           for m in range(n)]
+    grow = np.zeros((n, 5))
+    grow[~known] = (0.0, uncertainty.speed_error, uncertainty.accel, t0 - sensing.t,
+                    uncertainty.horizon)
     geo = base.geo.copy()
-    geo[VMAX_OBS] = float(np.hypot(*sensing.velocities.T).max()) + uncertainty.rate
+    predicted = np.hypot(*sensing.velocities[~known].T)
+    geo[VMAX_OBS] = max(float(predicted.max()) + uncertainty.rate if len(predicted) else 0.0,
+                        base.geo[VMAX_OBS] if known.any() else 0.0)
     return base._replace(geo=geo, m_kind=np.full(n, WAYPOINTS, np.int64),
-                         m_vel=np.zeros((n, 2)), m_wp_start=np.arange(0, 2 * n + 1, 2),
-                         m_wp=wp, m_grow=grow)
+                         m_vel=np.zeros((n, 2)),
+                         m_wp_start=np.concatenate([[0], np.cumsum([len(w) for w in wps])]).astype(np.int64),
+                         m_wp=np.vstack(wps), m_grow=grow)
+
+
+def _timetable(base: World, m: int, t0: float) -> np.ndarray:
+    """Motion ``m``'s true waypoints in a planner time that starts at absolute time ``t0``."""
+    if base.m_kind[m] == VELOCITY:
+        return np.array([[0.0, *(base.m_vel[m] * t0)],
+                         [HORIZON_S, *(base.m_vel[m] * (t0 + HORIZON_S))]])
+    wp = base.m_wp[base.m_wp_start[m]:base.m_wp_start[m + 1]].copy()
+    wp[:, 0] -= t0
+    return wp

@@ -24,7 +24,7 @@ from planner.problem import Problem
 from planner.rrt import Planner
 from planner.sim.control import Reference
 from planner.sim.predict import Uncertainty, predicted_world
-from planner.sim.sensing import Sensing
+from planner.sim.sensing import Sensing, known_motions
 from planner.timing import fastest_schedule
 
 __all__ = ["Cycle", "Replanner", "warm_up"]
@@ -70,6 +70,7 @@ class Replanner:
         self.iterations = iterations
         self.margin = margin
         self.uncertainty = uncertainty
+        self.known = known_motions(problem.scenario)
         self.horizon_s = horizon_s
         self.planner: Planner | None = None
         self.attached = False  # the reference from root_s on is the planner's best path
@@ -93,7 +94,8 @@ class Replanner:
         a = self.problem.scenario.vehicle.max_accel
         commit = max(v, 0.0) * lead_s + 0.5 * a * lead_s ** 2 if v > 1e-9 else 0.0
         root, anchor, skip, s_c = self._commit_point(pose, s_now, commit)
-        believed = predicted_world(self.problem.world, sensing, t + lead_s, self.uncertainty)
+        believed = predicted_world(self.problem.world, sensing, t + lead_s, self.uncertainty,
+                                   self.known)
         plan_world = inflated(believed, self.margin)
         if clearance(plan_world, root[0], root[1], 0.0) <= 0.0:
             plan_world = believed  # already inside the margin: plan with the bare disc

@@ -31,7 +31,7 @@ from planner.sim.metrics import AT_REST, MOVING, collision_runs, contacts, cycle
 from planner.sim.predict import Uncertainty, predicted_world
 from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
-from planner.sim.sensing import Sensing, mover_index, sense, true_offsets
+from planner.sim.sensing import Sensing, known_motions, mover_index, sense, true_offsets
 from planner.sim.vehicle import Limits, arc_step, limit_commands
 from planner.timing import warm_up as warm_up_timing
 from planner.tree import TreeSnapshot
@@ -170,7 +170,8 @@ def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertain
             commit: float, stuck: bool, done_s: float) -> Decision:
     """The guard's decision at a cycle's start, in the world the car believes in now (grown
     predictions, the planning margin; the bare car where it already is inside the margin)."""
-    believed = predicted_world(problem.world, sensing, t, uncertainty)
+    believed = predicted_world(problem.world, sensing, t, uncertainty,
+                               known_motions(problem.scenario))
     margin = GUARD_MARGIN * s.margin
     margin = margin if clearance(believed, state[0], state[1], 0.0) > margin else 0.0
     i = ref.project(state[0], state[1])[0] if ref is not None else 0

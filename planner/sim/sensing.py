@@ -12,7 +12,7 @@ import numpy as np
 
 from planner._world import VELOCITY, World
 
-__all__ = ["Sensing", "mover_index", "sense", "true_offsets"]
+__all__ = ["Sensing", "known_motions", "mover_index", "sense", "true_offsets"]
 
 
 def mover_index(scenario) -> np.ndarray:
@@ -22,6 +22,12 @@ def mover_index(scenario) -> np.ndarray:
         out.append(m if ob.motion is not None else -1)
         m += ob.motion is not None
     return np.array(out, dtype=np.int64)
+
+
+def known_motions(scenario) -> np.ndarray:
+    """Per motion (world order), whether the car is told its timetable (`motion.known`)."""
+    return np.array([ob.motion.known for ob in scenario.obstacles if ob.motion is not None],
+                    dtype=bool)
 
 
 def true_offsets(world: World, movers: np.ndarray, times) -> np.ndarray:
