@@ -98,7 +98,7 @@ class Access:
                 return False
         elif scheme.lower() != "bearer":
             return False
-        return hmac.compare_digest(value.strip().encode(), self.token.encode())
+        return hmac.compare_digest(value.strip().encode(errors="replace"), self.token.encode())
 
     @property
     def studio_pass(self) -> str:
@@ -115,4 +115,7 @@ class Access:
         except CookieError:
             return False
         morsel = jar.get(COOKIE)
-        return morsel is not None and hmac.compare_digest(morsel.value, self.studio_pass)
+        # As bytes: compare_digest refuses non-ASCII str (a 500 before), and a websocket's
+        # headers may hold undecodable bytes as surrogates.
+        return morsel is not None and hmac.compare_digest(
+            morsel.value.encode(errors="replace"), self.studio_pass.encode())

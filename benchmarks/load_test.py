@@ -3,6 +3,10 @@ while hostile clients attack; honest plans must keep their latency within a boun
 
     python benchmarks/load_test.py [--duration 20] [--max-p95-ratio 8] [--json]
 
+Beside them, while under attack: 100 idle studio tabs, 20 slow-header (slowloris) connections
+on each port and a /health watch (every 0.25 s, each answer within 1 s). At the end the server
+gets SIGTERM, and it and all its children must be gone within 10 s.
+
 Hostile work that holds a planning worker (a plan over 10 000 circles whose client gives up
 after 1 s, jobs of 20 s runs and 600 s simulations that are deleted) must be stopped by the
 server's deadlines and cancellation within a second or two; without that, the honest plans
@@ -19,6 +23,8 @@ import argparse
 import json
 import os
 import re
+import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -32,22 +38,25 @@ import httpx
 import numpy as np
 
 MB = 1024 * 1024
+IDLE_TABS = 100  # studio websockets held open, reading nothing, while under attack
+SLOW_CLIENTS = 20  # slow-header connections to each port
 CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
 
 
 # -- the server: a real subprocess, its process tree's memory and its workers' CPU
 
-def start_server(data_dir: str) -> tuple[subprocess.Popen, str]:
-    """`trackstar serve` on free loopback ports; returns the process and the API's base URL."""
+def start_server(data_dir: str) -> tuple[subprocess.Popen, str, int]:
+    """`trackstar serve` on free loopback ports; returns the process, the API's base URL and
+    the studio's port."""
     proc = subprocess.Popen(["trackstar", "serve", "--port", "0", "--ui-port", "0",
                              "--data-dir", data_dir], stdout=subprocess.PIPE, text=True)
     url = None
     for line in proc.stdout:  # bounded: the process prints its start lines or exits
         if m := re.fullmatch(r"API: (http://.+:\d+)/docs\n", line):
             url = m[1]
-        if line.startswith("UI: ") and url:
+        if (m := re.fullmatch(r"UI: http://.+:(\d+)/\n", line)) and url:
             threading.Thread(target=proc.stdout.read, daemon=True).start()  # never blocks it
-            return proc, url.replace("://localhost:", "://127.0.0.1:")
+            return proc, url.replace("://localhost:", "://127.0.0.1:"), int(m[1])
     raise RuntimeError("the server did not start")
 
 
@@ -154,6 +163,20 @@ NUMBERS = [_SCENARIO.replace("[0, 0, 10, 10]", "[0, 0, 1e308, 1e308]"),
            _SCENARIO.replace('"radius": 1', '"radius": Infinity'),
            _SCENARIO.replace("[9, 9, 0]", "[9, 9, 1e309]")]
 JSON = {"content-type": "application/json"}
+_STUDY = {"name": "huge", "scenarios": ["slalom"], "planners": ["rrt"],
+          "budget": {"iterations": 100}}
+HUGE_STUDIES = [{**_STUDY, "seeds": 1_000_000},  # ~100-byte bodies that once froze the API
+                {**_STUDY, "parameters": {"eps": [1 + i / 1000 for i in range(150)],
+                                          "gamma": [1 + i / 100 for i in range(150)],
+                                          "goal_bias": [i / 20 for i in range(10)]}},
+                {**_STUDY, "parameters": {"eps": {"min": 0.5, "max": 2.0}}, "sample": 300_000}]
+FAN_OUT = (b'<svg xmlns="http://www.w3.org/2000/svg"><defs><g id="l0"/>'  # 2**22 clones
+           + b"".join(f'<g id="l{i}"><use href="#l{i - 1}"/><use href="#l{i - 1}"/></g>'.encode()
+                      for i in range(1, 22))
+           + b'</defs><use href="#l21"/><use href="#l21"/></svg>')
+LONG_CSV = b"".join(f"{i * 0.01:.2f},{(i % 7) * 0.01:.2f},1.5,1.5\n".encode()
+                    for i in range(180_000))  # 180 000 rows, 4 MB
+FLOOD = {"scenarios": ["slalom"], "parameters": [{"time": 8}], "seeds": list(range(50))}
 
 
 def hostile_plan(client: httpx.Client, i: int) -> list[str]:
@@ -237,6 +260,35 @@ def hostile_host(client: httpx.Client, i: int) -> list[str]:
     return [f"POST {resp.status_code}"]
 
 
+def hostile_study(client: httpx.Client, i: int) -> list[str]:
+    resp = client.post("/api/v1/studies", json=HUGE_STUDIES[i % len(HUGE_STUDIES)])
+    return [f"POST {resp.status_code}"]
+
+
+def hostile_fan_out(client: httpx.Client, i: int) -> list[str]:
+    resp = client.post("/api/v1/tracks", files={"file": ("clones.svg", FAN_OUT)})
+    return [f"POST {resp.status_code}"]
+
+
+def hostile_csv(client: httpx.Client, i: int) -> list[str]:
+    resp = client.post("/api/v1/tracks", files={"file": ("long.csv", LONG_CSV)})
+    return [f"POST {resp.status_code}"]
+
+
+def hostile_flood(client: httpx.Client, i: int) -> list[str]:
+    """Six jobs of 50 runs × 8 s from one address, deleted after 3 s."""
+    posted = [client.post("/api/v1/jobs", json={**FLOOD, "seeds": [i * 50 + k for k in
+                                                                   range(50)]})
+              for _ in range(6)]
+    time.sleep(3)
+    answers = [f"POST {resp.status_code}" for resp in posted]
+    for resp in posted:
+        if resp.status_code == 202:
+            deleted = client.delete(f"/api/v1/jobs/{resp.json()['id']}")
+            answers.append(f"DELETE {deleted.status_code} {deleted.json().get('status')}")
+    return answers
+
+
 # kind → (attack, the answers it may get)
 HOSTILE = {
     "plan 10 000 circles, time 30 s, client gives up after 1 s": (
@@ -252,6 +304,11 @@ HOSTILE = {
     "NaN, Infinity, 1e308 numbers": (hostile_numbers, {"POST 422"}),
     "cross-origin write (Origin: https://evil.example)": (hostile_origin, {"POST 403"}),
     "wrong Host header": (hostile_host, {"GET 400", "POST 400"}),
+    "study of 10⁶ seeds, a 225 000-point grid, 300 000 samples": (hostile_study, {"POST 422"}),
+    "SVG of <use> clones of clones (2²² from 1.3 KB)": (hostile_fan_out, {"POST 400"}),
+    "centreline CSV of 180 000 rows": (hostile_csv, {"POST 400"}),
+    "flood: 6 jobs × 50 runs × 8 s, DELETE after 3 s": (
+        hostile_flood, {"POST 202", "POST 429", "DELETE 200 cancelled"}),
 }
 
 
@@ -273,26 +330,94 @@ def hostile_client(url: str, kind: str, stop_at: float, pause: float, out: Count
             time.sleep(pause)
 
 
+# -- background clients of the attack phase: idle studio tabs, slow headers, a /health watch
+
+def idle_websockets(ui_port: int, n: int, stop_at: float, out: dict) -> None:
+    """Open ``n`` studio websockets and hold them, reading nothing, until ``stop_at``."""
+    import viser
+    from websockets.sync.client import connect
+
+    sockets = []
+    for _ in range(n):
+        try:
+            sockets.append(connect(f"ws://127.0.0.1:{ui_port}/", open_timeout=10,
+                                   subprotocols=[f"viser-v{viser.__version__}"],
+                                   additional_headers={"Origin": f"http://127.0.0.1:{ui_port}"}))
+        except (OSError, TimeoutError) as exc:
+            out.setdefault("errors", []).append(type(exc).__name__)
+    out["opened"] = len(sockets)
+    time.sleep(max(0.0, stop_at - time.monotonic()))
+    for ws in sockets:
+        ws.close()
+
+
+def slow_headers(port: int, n: int, stop_at: float, out: dict) -> None:
+    """``n`` connections that send a request's headers a byte every 2 s (slowloris); counts
+    how many the server closed before ``stop_at``."""
+    conns = []
+    for _ in range(n):
+        conn = socket.create_connection(("127.0.0.1", port), timeout=5)
+        conn.sendall(b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n")
+        conns.append(conn)
+    closed = 0
+    while time.monotonic() < stop_at and conns:
+        time.sleep(2.0)
+        for conn in list(conns):
+            try:
+                conn.sendall(b"X")
+            except OSError:
+                conns.remove(conn)
+                closed += 1
+    for conn in conns:
+        conn.close()
+    out[port] = closed
+
+
+def watch_health(url: str, stop_at: float, out: dict) -> None:
+    """GET /health every 0.25 s with a 1 s timeout: the slowest answer and the misses."""
+    slowest, missed = 0.0, 0
+    with httpx.Client(base_url=url, timeout=1.0) as client:
+        while time.monotonic() < stop_at:
+            start = time.monotonic()
+            try:
+                ok = client.get("/health").status_code == 200
+            except httpx.HTTPError:
+                ok = False
+            slowest = max(slowest, time.monotonic() - start)
+            missed += not ok
+            time.sleep(0.25)
+    out.update(slowest_s=slowest, missed=missed)
+
+
 # -- phases and the report
 
-def run_phase(url: str, duration: float, hostile: bool,
-              pause: float) -> tuple[list, Counter, dict]:
-    """Run the clients for ``duration`` s: honest records, hostile answers, slowest rounds."""
+def run_phase(url: str, ui_port: int, duration: float, hostile: bool,
+              pause: float) -> tuple[list, Counter, dict, dict]:
+    """Run the clients for ``duration`` s: honest records, hostile answers, slowest rounds,
+    and what the background clients saw (idle tabs, slow headers, /health)."""
     honest: list = []
     answers = {kind: Counter() for kind in HOSTILE}  # one per thread: no shared counter
     slowest: dict[str, float] = {}
+    seen: dict = {"websockets": {}, "slow_headers": {}, "health": {}}
     stop_at = time.monotonic() + duration
     threads = [threading.Thread(target=honest_client, args=(url, seed, stop_at, honest))
                for seed in (0, 1)]
+    threads.append(threading.Thread(target=watch_health, args=(url, stop_at, seen["health"])))
     if hostile:
         threads += [threading.Thread(target=hostile_client,
                                      args=(url, kind, stop_at, pause, answers[kind], slowest))
                     for kind in HOSTILE]
+        api_port = int(url.rsplit(":", 1)[1])
+        threads += [threading.Thread(target=idle_websockets,
+                                     args=(ui_port, IDLE_TABS, stop_at, seen["websockets"])),
+                    *(threading.Thread(target=slow_headers,
+                                       args=(port, SLOW_CLIENTS, stop_at, seen["slow_headers"]))
+                      for port in (api_port, ui_port))]
     for thread in threads:
         thread.start()
     for thread in threads:
         thread.join()
-    return honest, sum(answers.values(), Counter()), slowest
+    return honest, sum(answers.values(), Counter()), slowest, seen
 
 
 def idle_after(root: int, limit: float = 15.0) -> float | None:
@@ -349,6 +474,13 @@ def table(result: dict) -> str:
         *(f"- {u}" for u in result["unexpected"]),
         (f"workers idle {'never (15 s)' if idle is None else f'{idle:.1f} s'} after the last "
          f"client stopped; peak RSS of the server's process tree {result['peak_rss_mb']:.0f} MB"),
+        (f"/health throughout: slowest {result['health_slowest_s']:.2f} s, missed "
+         f"{result['health_missed']}; {result['idle_tabs_opened']} idle studio tabs held open; "
+         f"slow-header connections closed by the server (per port): "
+         f"{result['slow_headers_closed']}"),
+        (f"SIGTERM ended the server and its children in {result['sigterm_s']:.1f} s"
+         if result.get("sigterm_s") is not None else
+         "SIGTERM: the server or a child was still alive after 10 s"),
         (f"afterwards: /health {result['health_after']}, a plain plan "
          f"{'solved' if result['plan_after_solved'] else 'did NOT solve'} in "
          f"{result['plan_after_s']:.2f} s"),
@@ -358,7 +490,7 @@ def table(result: dict) -> str:
     return "\n".join(rows)
 
 
-def measure(proc: subprocess.Popen, url: str, duration: float, pause: float,
+def measure(proc: subprocess.Popen, url: str, ui_port: int, duration: float, pause: float,
             max_p95_ratio: float) -> dict:
     sampler = RssSampler(proc.pid)
     sampler.start()
@@ -372,11 +504,12 @@ def measure(proc: subprocess.Popen, url: str, duration: float, pause: float,
             thread.join()
     t0 = time.monotonic()
     print(f"alone: 2 honest clients for {duration:g} s", file=sys.stderr, flush=True)
-    alone, _, _ = run_phase(url, duration, hostile=False, pause=pause)
+    alone, _, _, calm = run_phase(url, ui_port, duration, hostile=False, pause=pause)
     t1 = time.monotonic()
     print(f"under attack: 2 honest + {len(HOSTILE)} hostile clients for {duration:g} s",
           file=sys.stderr, flush=True)
-    attack, answers, slowest = run_phase(url, duration, hostile=True, pause=pause)
+    attack, answers, slowest, seen = run_phase(url, ui_port, duration, hostile=True,
+                                               pause=pause)
     t2 = time.monotonic()
     idle = idle_after(proc.pid)
     with httpx.Client(base_url=url, timeout=30) as client:
@@ -408,6 +541,10 @@ def measure(proc: subprocess.Popen, url: str, duration: float, pause: float,
         "health_after": health_after,
         "plan_after_solved": plan.status_code == 200 and plan.json()["solved"],
         "plan_after_s": plan_after_s,
+        "health_slowest_s": max(calm["health"]["slowest_s"], seen["health"]["slowest_s"]),
+        "health_missed": calm["health"]["missed"] + seen["health"]["missed"],
+        "idle_tabs_opened": seen["websockets"].get("opened", 0),
+        "slow_headers_closed": seen["slow_headers"],
     }
     result["p50_ratio"] = result["under_attack"]["p50_s"] / result["alone"]["p50_s"]
     result["p95_ratio"] = result["under_attack"]["p95_s"] / result["alone"]["p95_s"]
@@ -425,12 +562,39 @@ def failures(result: dict) -> list[str]:
         why.append(f"/health afterwards: {result['health_after']}")
     if not result["plan_after_solved"]:
         why.append("a plain plan afterwards did not solve")
+    if result["health_missed"] or result["health_slowest_s"] > 1.0:
+        why.append(f"/health missed {result['health_missed']} times, slowest "
+                   f"{result['health_slowest_s']:.2f} s (limit 1 s)")
+    if result["idle_tabs_opened"] < IDLE_TABS:
+        why.append(f"only {result['idle_tabs_opened']} of {IDLE_TABS} studio tabs opened")
+    if not result.get("sigterm_s", 0.0) <= 10.0:  # None: the tree outlived 10 s
+        why.append("SIGTERM did not end the server and all its children within 10 s")
     if result["workers_idle_after_s"] is None:
         why.append("the workers were still busy 15 s after the last client stopped")
     if not result["p95_ratio"] <= result["max_p95_ratio"]:  # NaN (no honest plan) fails too
         why.append(f"honest p95 under attack is {result['p95_ratio']:.2f} × its p95 alone "
                    f"(limit {result['max_p95_ratio']:g})")
     return why
+
+
+def terminate(proc: subprocess.Popen, limit: float = 10.0) -> float | None:
+    """SIGTERM the server; seconds until it and every child have ended (None: not within
+    ``limit``, and then they are killed)."""
+    tree = process_tree(proc.pid)
+    start = time.monotonic()
+    proc.send_signal(signal.SIGTERM)
+    while time.monotonic() - start < limit:
+        if proc.poll() is not None and not any(Path(f"/proc/{pid}").exists()
+                                               for pid in tree if pid != proc.pid):
+            return time.monotonic() - start
+        time.sleep(0.05)
+    for pid in tree:
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    proc.wait()
+    return None
 
 
 def main() -> None:
@@ -444,12 +608,12 @@ def main() -> None:
     parser.add_argument("--json", action="store_true", help="print a JSON object, no table")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as data_dir:
-        proc, url = start_server(data_dir)
+        proc, url, ui_port = start_server(data_dir)
         try:
-            result = measure(proc, url, args.duration, args.pause, args.max_p95_ratio)
+            result = measure(proc, url, ui_port, args.duration, args.pause, args.max_p95_ratio)
         finally:
-            proc.terminate()
-            proc.wait(30)
+            sigterm_s = terminate(proc)
+    result["sigterm_s"] = sigterm_s
     result["failures"] = failures(result)
     report = table(result)
     print(json.dumps(result, indent=1) if args.json else report)

@@ -89,6 +89,8 @@ def test_studio_sign_in_sets_a_cookie_for_the_studio_port(server):
     cookie = r.headers["set-cookie"]
     assert "HttpOnly" in cookie and "SameSite=strict" in cookie and TOKEN not in cookie
     assert bare.get("/studio").status_code == 303  # the cookie is enough from now on
+    odd = httpx.get(f"{server.url}/studio", headers={"Cookie": 'trackstar_studio="\u00e9"'.encode()})
+    assert odd.status_code == 401  # a non-ASCII cookie is a wrong one, not a 500
 
 
 def _studio(server, **headers) -> str:
@@ -114,3 +116,5 @@ def test_the_studio_websocket_needs_the_cookie_and_its_own_origin(server):
     assert _studio(server, Origin="http://evil.example", Cookie=cookie).startswith(
         "1008 origin 'http://evil.example'")
     assert _studio(server, Origin=COURSE, Cookie=cookie) == "open"
+    assert _studio(server, Origin=own, Cookie='trackstar_studio="\u00e9"').startswith(
+        "1008 sign in first")

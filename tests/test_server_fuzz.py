@@ -3,13 +3,19 @@
 
 from __future__ import annotations
 
+import asyncio
 import json
+import time
 
+import msgspec
 import pytest
+import viser
 from _server import Server
 from conftest import scenario_dict
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from websockets.asyncio.client import connect
+from websockets.exceptions import ConnectionClosed
 
 JSON = st.recursive(
     st.none() | st.booleans() | st.integers(-2**70, 2**70) | st.text(max_size=8)
@@ -95,3 +101,36 @@ def test_track_reads_never_fail_on_the_server(server, track, endpoint, query):
 def test_uploads_never_fail_on_the_server(server, svg, path, unit):
     form = {k: v for k, v in (("path", path), ("unit", unit)) if v is not None}
     check(server.client.post("/tracks", files={"file": ("f.svg", svg)}, data=form))
+
+
+def test_malformed_studio_frames_close_that_socket_with_one_log_line(server):
+    """Random bytes, a text frame and msgpack of the wrong types: each socket is closed and
+    logged in one line, without a traceback; the studio still opens for the next tab."""
+    frames = [bytes(range(256)) * 2, "hello", msgspec.msgpack.encode([1, 2, 3]),
+              msgspec.msgpack.encode({"type": "GuiUpdateMessage", "id": 5, "updates": 3}),
+              msgspec.msgpack.encode({"type": "ViewerCameraMessage", "wxyz": 1})]
+    before = len(server.err)
+
+    async def send(frame) -> str:
+        async with connect(f"ws://127.0.0.1:{server.ui_port}/",
+                           subprotocols=[f"viser-v{viser.__version__}"],
+                           additional_headers={"Origin": f"http://127.0.0.1:{server.ui_port}"}
+                           ) as ws:
+            await asyncio.wait_for(ws.recv(), 30)
+            if frame is None:
+                return "open"
+            await ws.send(frame)
+            try:
+                while True:
+                    await asyncio.wait_for(ws.recv(), 10)
+            except ConnectionClosed as closed:
+                return f"closed {closed.rcvd.code}"
+
+    for frame in frames:
+        assert asyncio.run(send(frame)).startswith("closed"), frame
+    assert asyncio.run(send(None)) == "open"
+    time.sleep(0.5)  # the reader thread takes the last lines
+    logged = [line for line in server.err[before:] if "warn" not in line.lower()]
+    closes = [line for line in logged if "closed a websocket that sent a malformed" in line]
+    assert len(closes) == len(frames), logged
+    assert not any("Traceback" in line or line.startswith("  ") for line in logged), logged

@@ -112,9 +112,44 @@ def test_delete_and_a_client_that_gives_up_stop_their_plans_in_the_workers(serve
     job_id = server.client.post("/jobs", json=long_runs).json()["id"]
     time.sleep(1.0)
     server.client.delete(f"/jobs/{job_id}")
-    assert quick_plan_s() < 5.0
-    for _ in range(2):
+    start = time.monotonic()  # the batch lane's workers are free: a short job runs at once
+    quick = server.client.post("/jobs", json={**long_runs, "parameters": [{"time": 0.1}]})
+    assert server.wait_job(quick.json()["id"], timeout=5.0)["status"] == "done"
+    assert time.monotonic() - start < 5.0
+    for _ in range(3):  # every worker: the two of the batch lane and the interactive one
         with pytest.raises(httpx.ReadTimeout):
             server.client.post("/plan", json={"scenario_id": "slalom", "time": 20.0},
                                timeout=1.0)
     assert quick_plan_s() < 5.0
+
+
+def test_a_plan_answers_at_once_while_jobs_flood_the_server_from_the_same_address(server):
+    """Issue 32: six jobs of 50 runs × 8 s, then a 0.3 s plan timed out at 30 s. Plans have
+    their own lane now, and batch work never takes its worker."""
+    flood = {"scenarios": [scenario_dict("slalom")], "parameters": [{"time": 8.0}],
+             "seeds": list(range(50))}
+    jobs = [server.client.post("/jobs", json=flood) for _ in range(6)]
+    assert all(job.status_code == 202 for job in jobs)
+    time.sleep(1.0)
+    for _ in range(3):
+        start = time.monotonic()
+        plan = server.client.post("/plan", json={"scenario_id": "slalom", "time": 0.3})
+        assert plan.status_code == 200 and time.monotonic() - start < 5.0, plan.text
+    for job in jobs:
+        server.client.delete(f"/jobs/{job.json()['id']}")
+
+
+def test_too_many_queued_runs_from_one_client_get_429_with_retry_after(server):
+    """A client may have 10 000 runs queued or running; beyond, a job waits its turn outside
+    (nothing is stored or started), and the client is told when to come back."""
+    body = {"scenarios": [scenario_dict("slalom")], "parameters": [{"iterations": 1}],
+            "seeds": list(range(10_000))}
+    first = server.client.post("/jobs", json=body)
+    assert first.status_code == 202
+    again = server.client.post("/jobs", json={**body, "seeds": [0]})
+    assert again.status_code == 429, again.text
+    assert "per client" in again.json()["detail"] and int(again.headers["Retry-After"]) >= 1
+    server.client.delete(f"/jobs/{first.json()['id']}")
+    later = server.client.post("/jobs", json={**body, "seeds": [0]})
+    assert later.status_code == 202  # the cancelled job's runs left the queue
+    server.wait_job(later.json()["id"])

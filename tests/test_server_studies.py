@@ -7,6 +7,7 @@ import csv
 import io
 import sqlite3
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 from _server import Server
@@ -70,12 +71,33 @@ def test_a_study_runs_to_the_same_rows_as_the_command_line(server, tmp_path):
     (dict(STUDY, scenarios=["no_such_id"]), "scenarios[0]"),
     (dict(STUDY, parameters={"eps": [-1]}), "eps[0] = -1"),
     (dict(STUDY, budget={"time_s": 1e6}), "above this server's limit"),
-    (dict(STUDY, seeds=20000), "at most 10000"),
+    (dict(STUDY, seeds=20000), "expands to 80,000 runs"),
     (dict(STUDY, scenarios=[{"name": "x", "bounds": [0, 0, 1, 1]}]), "scenarios[0]: "),
 ])
 def test_a_bad_study_is_422_naming_the_key(server, body, words):
     answer = server.client.post("/studies", json=body)
     assert answer.status_code == 422 and words in answer.json()["detail"], answer.text
+
+
+@pytest.mark.parametrize("huge, words", [
+    ({"seeds": 1_000_000}, "a count of seeds is 1 to 100000"),
+    ({"parameters": {"eps": [1 + i / 1000 for i in range(150)],
+                     "gamma": [1 + i / 100 for i in range(150)],
+                     "goal_bias": [i / 20 for i in range(10)]}}, "expands to 900,000 runs"),
+    ({"parameters": {"eps": {"min": 0.5, "max": 2.0}}, "sample": 300_000}, "sample.n"),
+    ({"parameters": {"eps": {"min": 0.5, "max": 2.0}}, "sample": 20_000}, "at most 10,000"),
+])
+def test_a_study_too_big_is_refused_at_once_and_the_server_answers_meanwhile(server, huge,
+                                                                             words):
+    """Counted from the sizes of its axes, before anything is built, off the event loop
+    (issue 32: a 100-byte body took 25 s and froze /health)."""
+    with ThreadPoolExecutor(1) as pool:
+        posted = pool.submit(server.client.post, "/studies", json={**STUDY, **huge})
+        health = server.get("/health", timeout=1.0)
+        answer = posted.result(timeout=2.0)
+    assert health.status_code == 200
+    assert answer.status_code == 422 and words in answer.json()["detail"], answer.text
+    assert answer.elapsed.total_seconds() < 2.0
 
 
 def test_delete_stops_a_study_and_keeps_its_finished_runs(server):

@@ -92,6 +92,8 @@ def test_a_repeated_last_point_is_dropped_and_comments_semicolons_and_spaces_pas
     ("0,0,1,1\n1,0,1,1\n2,1,-1,1\n3,3,1,1\n", "line 3: negative width"),
     ("0,0,1,1\n1,0,1,1\n1,0,1,1\n3,3,1,1\n", "line 3: repeats the point of line 2"),
     ("0,0,1,1\n1,0,0,0\n2,1,1,1\n3,3,1,1\n", "line 2: the track has no width"),
+    ("1,2,1,1\n" * 200_000, "line 10001: more than 10000 rows"),  # counted while reading
+    ("".join(f"{i},0,1,1\n" for i in range(180_000)), "line 10001: more than 10000 rows"),
 ])
 def test_bad_csvs_raise_one_line_naming_the_line(text, words):
     with pytest.raises(TrackError, match=words) as err:

@@ -230,6 +230,27 @@ def test_bad_documents_raise_one_clear_track_error_quickly(data, message):
     assert time.perf_counter() - started < 1.0
 
 
+def _fan_out(levels: int, leaf: str) -> bytes:
+    """Clones of clones: each level's group shows the one below twice (2**levels leaves)."""
+    groups = [f'<g id="l0">{leaf}</g>'] + [
+        f'<g id="l{i}"><use href="#l{i - 1}"/><use href="#l{i - 1}"/></g>'
+        for i in range(1, levels + 1)]
+    return svg(f"<defs>{''.join(groups[:-1])}</defs>{groups[-1]}")
+
+
+@pytest.mark.parametrize(("data", "message"), [
+    (_fan_out(22, "<g/>"), "shows more than 50000 elements"),  # 1.2 KB, 4 million walks
+    (_fan_out(12, f'<path d="M 0 0 {"L 1 1 " * 2000}"/>'), "more than 40000 numbers"),
+    (svg("<g/>" * 1_300_000), "shows more than 50000 elements"),  # 5 MB of empty groups
+], ids=["empty clones", "clones of a long path", "empty groups"])
+def test_the_work_of_a_document_is_bounded_not_only_its_size(data, message):
+    """Issue 32: 2**18 clones took 55 s and no signal stopped them; now the walk counts."""
+    started = time.perf_counter()
+    with pytest.raises(TrackError, match=message):
+        load_svg(data)
+    assert time.perf_counter() - started < 5.0
+
+
 def test_a_missing_file_is_a_track_error():
     with pytest.raises(TrackError, match="cannot read"):
         load_svg(DATA / "no-such-file.svg")

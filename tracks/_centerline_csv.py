@@ -20,6 +20,9 @@ from tracks._track import Track
 
 COLUMNS = ("x_m", "y_m", "w_tr_right_m", "w_tr_left_m")
 _SEPARATOR = re.compile(r"\s*[,;]\s*")
+# Rows of one file: a 10 km track at 1 m spacing. Each row becomes a Bézier that is measured,
+# so this bounds a load to about two seconds; the TUM and F1TENTH tracks have 1 000 to 5 000.
+MAX_ROWS = 10_000
 
 
 def _rows(text: str, name: str) -> tuple[np.ndarray, list[int]]:
@@ -44,6 +47,9 @@ def _rows(text: str, name: str) -> tuple[np.ndarray, list[int]]:
             raise TrackError(f"{where}: negative width")
         rows.append(values)
         lines.append(number)
+        if len(rows) > MAX_ROWS:
+            raise TrackError(f"{where}: more than {MAX_ROWS} rows; resample the centreline "
+                             f"more coarsely (every metre is plenty for planning)")
     return np.array(rows).reshape(-1, 4), lines
 
 

@@ -36,6 +36,9 @@ _CONTAINERS = frozenset({"g", "svg", "a", "switch"})
 _MAX_ELEMENTS = 20_000
 DEFAULT_WIDTH_M = 0.5  # a track drawn with a zero stroke width (a hairline) gets this width
 _MAX_USE_DEPTH = 32
+# Elements walked, a <use> clone's elements counted each time they are shown: clones of clones
+# fan out (two per level, 22 levels: 4 million walks from 1.2 KB), so the walk itself is bounded.
+_MAX_WALKED = 50_000
 _MAX_NESTING = 200  # elements inside elements; editors write a few levels, Python's stack ~1000
 # Per document: each segment costs ~0.15 ms to measure, and one takes 1 to 7 numbers, so this
 # bounds a load to a few seconds (counted without parsing, so small files stay fast).
@@ -115,10 +118,16 @@ class _Walker:
     def __init__(self, root: ET.Element) -> None:
         self.by_id = {e.attrib["id"]: e for e in root.iter() if "id" in e.attrib}
         self.found: list[_Element] = []
+        self.walked = 0
+        self.numbers = 0  # of the path data found, clones counted each time
 
     def walk(self, elem, matrix, inherited, clone=None, uses=(), depth=0) -> None:
         if not elem.tag.startswith(SVG):
             return
+        self.walked += 1
+        if self.walked > _MAX_WALKED:
+            raise TrackError(f"the document shows more than {_MAX_WALKED} elements (<use> "
+                             f"clones counted each time they are shown)")
         if depth > _MAX_NESTING:
             raise TrackError(f"elements nested more than {_MAX_NESTING} deep")
         tag = elem.tag[len(SVG) :]
@@ -151,6 +160,10 @@ class _Walker:
             return
         if len(self.found) >= _MAX_ELEMENTS:
             raise TrackError(f"more than {_MAX_ELEMENTS} path-like elements")
+        self.numbers += len(_NUMBER.findall(data))
+        if self.numbers > _MAX_PATH_NUMBERS:
+            raise TrackError(f"too many path segments: the path data holds more than "
+                             f"{_MAX_PATH_NUMBERS} numbers")
         named = clone if clone is not None else elem
         self.found.append(
             _Element(
@@ -168,10 +181,6 @@ def collect_elements(root: ET.Element) -> list[_Element]:
     """Every rendered path-like element of the document, in document order."""
     walker = _Walker(root)
     walker.walk(root, np.eye(3), {})
-    numbers = sum(len(_NUMBER.findall(elem.path_data)) for elem in walker.found)
-    if numbers > _MAX_PATH_NUMBERS:
-        raise TrackError(f"too many path segments: the path data holds {numbers} numbers, "
-                         f"the limit is {_MAX_PATH_NUMBERS}")
     return walker.found
 
 

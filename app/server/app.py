@@ -23,6 +23,7 @@ from app.server import (
     routes_studies,
     routes_tracks,
 )
+from app.server.fair_queue import Busy
 from app.server.jobs import Planning, WorkerCrashed
 from app.server.models import INVALID_SCENARIO, Health
 from app.server.store import Store
@@ -159,6 +160,11 @@ def create_app(settings: ServerSettings) -> FastAPI:
     @app.exception_handler(ScenarioError)
     async def unplannable(request: Request, exc: ScenarioError) -> JSONResponse:
         return JSONResponse({"detail": str(exc)}, status_code=422)
+
+    @app.exception_handler(Busy)
+    async def busy(request: Request, exc: Busy) -> JSONResponse:
+        return JSONResponse({"detail": str(exc)}, status_code=429,
+                            headers={"Retry-After": str(exc.retry_after)})
 
     @app.exception_handler(WorkerCrashed)
     async def worker_crashed(request: Request, exc: WorkerCrashed) -> JSONResponse:

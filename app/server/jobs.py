@@ -1,10 +1,10 @@
 """Planning off the event loop: one process pool for single plans and batch jobs.
 
-The pool is sized to the machine and started as soon as the server's kernels are loaded
-(`app.kernels`; requests wait until then); each worker loads the planner's compiled kernels once
-(`warm_up` as its initializer), so no request pays for it. A job feeds
-the pool at most one run per worker at a time, so a single POST /plan waits for one run, not
-for a whole batch. At shutdown the workers are terminated (a plan may have up to --max-plan-s
+The pool is sized to the machine plus one worker and started as soon as the server's kernels
+are loaded (`app.kernels`; requests wait until then); each worker loads the planner's compiled
+kernels once (`warm_up` as its initializer), so no request pays for it. Every call takes a slot
+of the `FairQueue` first: plans go ahead of batch work and always find the extra worker free
+of it, and the runs of jobs, studies and simulations take turns client by client. At shutdown the workers are terminated (a plan may have up to --max-plan-s
 left) and unfinished jobs are marked failed, so a restart shows what was interrupted.
 
 Cancelling the task that awaits a call (a client gone, DELETE of its job, a simulation past
@@ -31,6 +31,7 @@ from pathlib import Path
 from app import kernels
 from app.planning import TrackSource, check_scenario, run_plan
 from app.pool import StopFlag, first_line, machine_workers, start_pool, stop_pool
+from app.server.fair_queue import FairQueue, Ticket
 from app.server.store import Store
 from app.simulation import SimOptions, read_progress, run_simulation
 from app.study.report import write_report
@@ -71,6 +72,7 @@ class Planning:
         self.max_plan_s = max_plan_s
         self.max_sim_s = max_sim_s  # wall time a simulation may keep a worker busy
         self.workers = workers or machine_workers()
+        self.queue = FairQueue(self.workers)
         # Started once the kernels are loaded (`app.kernels`): the workers then load them from
         # numba's cache instead of each compiling them beside the server on a first start.
         self.pool: ProcessPoolExecutor | None = None
@@ -86,7 +88,7 @@ class Planning:
         store.fail_unfinished(CRASHED)
 
     def _start_pool(self) -> ProcessPoolExecutor:
-        return start_pool(self.workers)
+        return start_pool(self.queue.slots)
 
     @property
     def started(self) -> bool:
@@ -103,18 +105,20 @@ class Planning:
     def _flag(self) -> StopFlag:
         return StopFlag(self.stop_dir / uuid.uuid4().hex)
 
-    async def _call(self, fn, *args, **kwargs):
-        """``fn(*args, **kwargs)`` in a worker; a ``stop`` keyword is the call's StopFlag."""
+    async def _call(self, fn, *args, ticket: Ticket | None = None, **kwargs):
+        """``fn(*args, **kwargs)`` in a worker, in the interactive lane, or with a ``ticket``
+        in the batch lane; a ``stop`` keyword is the call's StopFlag."""
         call = functools.partial(fn, *args, **kwargs)
         await self._pool_started.wait()  # plans wait for the kernels, they do not fail
-        pool = self.pool
-        try:
-            return await _submit(pool, call)
-        except BrokenProcessPool:  # a worker died with this call in flight: replace the pool
-            if self.pool is pool:
-                self.pool = self._start_pool()
-                pool.shutdown(wait=False, cancel_futures=True)
-        return await self._alone(call)
+        async with self.queue.slot(ticket):
+            pool = self.pool
+            try:
+                return await _submit(pool, call)
+            except BrokenProcessPool:  # a worker died with this call in flight: a new pool
+                if self.pool is pool:
+                    self.pool = self._start_pool()
+                    pool.shutdown(wait=False, cancel_futures=True)
+            return await self._alone(call)
 
     @staticmethod
     async def _alone(call: functools.partial):
@@ -137,23 +141,27 @@ class Planning:
         await self._call(check_scenario, scenario, track)
 
     async def plan(self, scenario: Scenario, options: PlanOptions,
-                   track: TrackSource | None) -> PlanReport:
+                   track: TrackSource | None, ticket: Ticket | None = None) -> PlanReport:
         return await self._call(run_plan, scenario, options, max_time=self.max_plan_s,
-                                track=track, stop=self._flag())
+                                track=track, stop=self._flag(), ticket=ticket)
 
-    def start_job(self, runs: list[tuple[Scenario, PlanOptions, TrackSource | None]]) -> str:
+    def admit(self, client: str, runs: int) -> Ticket:
+        """Admit a batch submission of ``runs`` runs or raise `fair_queue.Busy` (429)."""
+        return self.queue.admit(client, runs)
+
+    def start_job(self, runs: list[tuple[Scenario, PlanOptions, TrackSource | None]],
+                  ticket: Ticket) -> str:
         """Store a job and run it in the background; returns its id."""
         job_id = self.store.add_job(len(runs))
-        self._jobs[job_id] = asyncio.get_running_loop().create_task(self._run(job_id, runs))
+        task = self._run(job_id, runs, ticket)
+        self._jobs[job_id] = asyncio.get_running_loop().create_task(task)
         return job_id
 
-    async def _run(self, job_id: str, runs) -> None:
-        free = asyncio.Semaphore(self.workers)
+    async def _run(self, job_id: str, runs, ticket: Ticket) -> None:
+        ticket.on_start = lambda: self.store.set_job_status(job_id, "running")
 
         async def one(idx: int, scenario, options: PlanOptions, track) -> None:
-            async with free:
-                self.store.set_job_status(job_id, "running")
-                report = await self.plan(scenario, options, track)
+            report = await self.plan(scenario, options, track, ticket)
             row = {**report.model_dump(mode="json", exclude={"path"}), "seed": options.seed}
             self.store.add_result(job_id, idx, row)
 
@@ -166,13 +174,14 @@ class Planning:
         else:
             self.store.set_job_status(job_id, "done")
         finally:
+            ticket.close()
             self._jobs.pop(job_id, None)
 
     def start_simulation(self, scenario: Scenario, options: SimOptions,
-                         track: TrackSource | None) -> str:
+                         track: TrackSource | None, ticket: Ticket) -> str:
         """Store a simulation and run it in the background on the pool; returns its id."""
         sim_id = self.store.add_simulation(scenario.name, options.model_dump())
-        task = self._simulate(sim_id, scenario, options, track)
+        task = self._simulate(sim_id, scenario, options, track, ticket)
         self._jobs[sim_id] = asyncio.get_running_loop().create_task(task)
         return sim_id
 
@@ -194,13 +203,13 @@ class Planning:
             task.cancel()
 
     async def _simulate(self, sim_id: str, scenario: Scenario, options: SimOptions,
-                        track) -> None:
+                        track, ticket: Ticket) -> None:
         progress = self._progress(sim_id)
+        ticket.on_start = lambda: self.store.set_simulation(sim_id, "running")
         try:
-            self.store.set_simulation(sim_id, "running")
             summary = await asyncio.wait_for(
                 self._call(run_simulation, scenario, options, track, self.sim_log(sim_id),
-                           progress, stop=self._flag()), self.max_sim_s)
+                           progress, stop=self._flag(), ticket=ticket), self.max_sim_s)
         except TimeoutError:
             self.store.set_simulation(sim_id, "failed", error=(
                 f"stopped after {self.max_sim_s:g} s of wall time, this server's limit for a "
@@ -210,6 +219,7 @@ class Planning:
         else:
             self.store.set_simulation(sim_id, "done", summary=summary)
         finally:
+            ticket.close()
             progress.unlink(missing_ok=True)
             self._jobs.pop(sim_id, None)
 
@@ -217,23 +227,22 @@ class Planning:
     def study_dir(self, study_id: str) -> Path:
         return self.studies_dir / study_id
 
-    def start_study(self, study_id: str, study: Study) -> None:
+    def start_study(self, study_id: str, study: Study, ticket: Ticket) -> None:
         """Run (or resume) a study in the background: the runs its directory does not hold."""
-        task = self._study(study_id, study)
+        task = self._study(study_id, study, ticket)
         self._jobs[study_id] = asyncio.get_running_loop().create_task(task)
 
-    async def _study(self, study_id: str, study: Study) -> None:
+    async def _study(self, study_id: str, study: Study, ticket: Ticket) -> None:
         out = self.study_dir(study_id)
         results = Results(out, study.name, study.kind, study.text)
-        free = asyncio.Semaphore(self.workers)
 
         async def one(run) -> None:
-            async with free:
-                try:
-                    outcome, curve = await self._call(execute, study.scenarios[run.scenario],
-                                                      run, self.max_plan_s, stop=self._flag())
-                except WorkerCrashed as exc:  # stored like any failed run; the others go on
-                    outcome, curve = {"error": first_line(exc)}, []
+            try:
+                outcome, curve = await self._call(execute, study.scenarios[run.scenario], run,
+                                                  self.max_plan_s, stop=self._flag(),
+                                                  ticket=ticket)
+            except WorkerCrashed as exc:  # stored like any failed run; the others go on
+                outcome, curve = {"error": first_line(exc)}, []
             results.add(run, outcome, curve)
 
         try:
@@ -250,6 +259,7 @@ class Planning:
         else:
             self.store.set_study(study_id, "done")
         finally:
+            ticket.close()
             results.close()
             self._jobs.pop(study_id, None)
 

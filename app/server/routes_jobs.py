@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import asyncio
 import csv
 import io
 
 from fastapi import APIRouter, HTTPException, Request, Response
 
+from app.server.fair_queue import client_of
 from app.server.models import JobCreated, JobRequest, JobStatus
 from app.server.routes_plan import plan_options
 from app.server.routes_scenarios import resolve
@@ -24,6 +26,19 @@ async def create_job(request: Request, body: JobRequest) -> JobCreated:
     if body.total > MAX_RUNS:
         raise HTTPException(422, f"{body.total} runs requested; a job may have at most "
                                  f"{MAX_RUNS}")
+    planning = request.app.state.planning
+    ticket = planning.admit(client_of(request), body.total)  # 429 beyond the queue's limits
+    try:
+        runs = await asyncio.to_thread(_runs, request, body)  # up to MAX_RUNS: not on the loop
+    except BaseException:
+        ticket.close()
+        raise
+    job_id = planning.start_job(runs, ticket)
+    return JobCreated(id=job_id, total=len(runs))
+
+
+def _runs(request: Request, body: JobRequest) -> list:
+    """The job's (scenario, options, track) runs, each checked."""
     scenarios = []
     for i, scenario in enumerate(body.scenarios):
         try:
@@ -32,9 +47,7 @@ async def create_job(request: Request, body: JobRequest) -> JobCreated:
             raise ScenarioError(f"scenarios[{i}]: {exc}") from None
     options = [plan_options(request, params, seed=seed)
                for params in body.parameters for seed in body.seeds]
-    runs = [(scenario, opts, track) for scenario, track in scenarios for opts in options]
-    job_id = request.app.state.planning.start_job(runs)
-    return JobCreated(id=job_id, total=len(runs))
+    return [(scenario, opts, track) for scenario, track in scenarios for opts in options]
 
 
 def _job(request: Request, job_id: str) -> dict:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from fastapi import APIRouter, HTTPException, Request
 from fastapi.responses import FileResponse
 
+from app.server.fair_queue import client_of
 from app.server.models import SimulationCreated, SimulationRequest, SimulationStatus
 from app.server.routes_scenarios import resolve
 from planner.sim.laps import require_track
@@ -24,8 +25,10 @@ async def create_simulation(request: Request, body: SimulationRequest) -> Simula
             require_track(scenario)
         except ValueError as exc:
             raise HTTPException(422, str(exc).removeprefix("--")) from None
-    await request.app.state.planning.check(scenario, track)
-    sim_id = request.app.state.planning.start_simulation(scenario, options, track)
+    planning = request.app.state.planning
+    await planning.check(scenario, track)
+    sim_id = planning.start_simulation(scenario, options, track,
+                                       planning.admit(client_of(request), 1))
     return SimulationCreated(id=sim_id)
 
 

@@ -18,6 +18,7 @@ from pydantic import BaseModel
 
 import planner
 import tracks
+from app.server.fair_queue import client_of
 from app.server.routes_jobs import MAX_RUNS
 from app.server.routes_scenarios import stored_scenario
 from app.study.report import write_report
@@ -64,7 +65,7 @@ def _inline(request: Request, body: dict) -> dict:
     return dict(body, scenarios=inlined)
 
 
-def _parse(body: dict) -> Study:
+def _parse(body: dict, max_runs: int = MAX_RUNS) -> Study:
     def resolve(source) -> planner.Scenario:
         if isinstance(source, dict):
             scenario = planner.parse_scenario(source)
@@ -76,13 +77,14 @@ def _parse(body: dict) -> Study:
                                         "an embedded SVG or CSV")
         return scenario
 
-    return parse_study(body, "", resolve)
+    return parse_study(body, "", resolve, max_runs=max_runs)
 
 
 def resume_unfinished(store, planning) -> None:
     """At start-up: go on with the studies a stopped server left unfinished."""
     for row in store.unfinished_studies():
-        planning.start_study(row["id"], _parse(row["body"]))
+        study = _parse(row["body"])
+        planning.start_study(row["id"], study, planning.queue.ticket("resumed", len(study.runs)))
 
 
 def _status(request: Request, study_id: str) -> dict:
@@ -109,20 +111,19 @@ async def create_study(
 ) -> StudyCreated:
     """Start a study; poll GET /studies/{id}, then fetch results.csv, report.html or
     results.sqlite. Runs are capped at --max-plan-s each."""
-    try:
-        body = _inline(request, body)
-        study = _parse(body)
+    try:  # in a thread: validating and expanding a study of many runs takes a while
+        body = await asyncio.to_thread(_inline, request, body)
+        study = await asyncio.to_thread(_parse, body)
     except StudyError as exc:
         raise HTTPException(422, str(exc)) from None
-    if len(study.runs) > MAX_RUNS:
-        raise HTTPException(422, f"{len(study.runs)} runs; a study may have at most {MAX_RUNS}")
     cap = request.app.state.planning.max_plan_s
     times = [r.budget_time_s for r in study.runs if getattr(r, "budget_time_s", None)]
     if times and max(times) > cap:
         raise HTTPException(422, f"budget.time_s: {max(times)} s is above this server's limit "
                                  f"of {cap} s")
+    ticket = request.app.state.planning.admit(client_of(request), len(study.runs))  # or 429
     study_id = request.app.state.store.add_study(study.name, body, len(study.runs))
-    request.app.state.planning.start_study(study_id, study)
+    request.app.state.planning.start_study(study_id, study, ticket)
     return StudyCreated(id=study_id, total=len(study.runs))
 
 

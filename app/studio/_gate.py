@@ -9,9 +9,12 @@ never gets a session. The page itself (viser's static client) is still served to
 
 from __future__ import annotations
 
+import logging
+
 import viser
 
 from app.access import Access
+from app.pool import first_line
 
 __all__ = ["Gate"]
 
@@ -28,6 +31,7 @@ class Gate:
         self._admitted: set[int] = set()  # live connections that passed
         self._ws.on_client_connect(self._check)
         self._ws.on_client_disconnect(lambda client: self._admitted.discard(client.client_id))
+        logging.getLogger("websockets.server").addFilter(_one_line)
 
     async def _check(self, client) -> None:
         connection = self._ws._live_connections.get(client.client_id)
@@ -55,3 +59,16 @@ def _one(headers, name: str) -> str | None:
     """The header's value, None if absent; '' if repeated, which every check refuses."""
     values = headers.get_all(name)
     return (values[0] if len(values) == 1 else "") if values else None
+
+
+def _one_line(record: logging.LogRecord) -> bool:
+    """A client that sends what viser cannot read (random bytes, text, msgpack of the wrong
+    types) fails viser's connection handler, and websockets closes that socket (1011): log it
+    as one line instead of a traceback per message."""
+    if record.msg == "connection handler failed" and record.exc_info:
+        exc = record.exc_info[1]
+        record.msg = "studio: closed a websocket that sent a malformed message (%s)"
+        record.args = (f"{type(exc).__name__}: {first_line(exc)[:200]}" if str(exc)
+                       else type(exc).__name__,)
+        record.exc_info = record.exc_text = None
+    return True

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,7 +30,7 @@ from planner.options import PLANNERS, PlanOptions, PositiveFinite, Seed
 from planner.steering import STEERINGS, SteeringName
 from planner.validation import StrictModel, describe, suggest
 
-__all__ = ["PARAMETERS", "SIM_PARAMETERS", "Run", "SimRun", "Study", "StudyError",
+__all__ = ["MAX_RUNS", "PARAMETERS", "SIM_PARAMETERS", "Run", "SimRun", "Study", "StudyError",
            "load_study", "parse_study", "study_names"]
 
 # The axes a study may sweep: `trackstar plan`'s and `trackstar simulate`'s options, under the
@@ -40,7 +41,13 @@ SIM_PARAMETERS = tuple(k for k in SimOptions.model_fields if k != "seed")
 _RRTSTAR_ONLY = ("gamma", "k_rrt", "informed")
 TARGETS = (*PLANNERS, *OMPL_PLANNERS)  # ours, and OMPL's with the bench extra
 
-Count = Annotated[int, Field(ge=1)]
+# The most runs one study may expand to here (a server sets its own, lower cap). A study is
+# counted from the sizes of its axes before anything is built (`StudyFile.size`), so a short
+# file cannot ask for unbounded work just to be refused.
+MAX_RUNS = 100_000
+Count = Annotated[int, Field(ge=1, le=MAX_RUNS)]
+MAX_VALUES = 1_000  # values on one axis of the grid (a parameter's, a budget's)
+Axis = Annotated[list[Any], Field(min_length=1, max_length=MAX_VALUES)]
 
 
 class StudyError(ValueError):
@@ -55,8 +62,8 @@ class Budget(StrictModel):
     """Per run: an iteration budget, a time budget, or both (whichever comes first); either
     may be a list, another axis of the grid."""
 
-    iterations: Annotated[list[Count], Field(min_length=1)] | None = None
-    time_s: Annotated[list[PositiveFinite], Field(min_length=1)] | None = None
+    iterations: Annotated[list[Count], Field(min_length=1, max_length=MAX_VALUES)] | None = None
+    time_s: Annotated[list[PositiveFinite], Field(min_length=1, max_length=MAX_VALUES)] | None = None
 
     @field_validator("iterations", "time_s", mode="before")
     @classmethod
@@ -110,10 +117,10 @@ class StudyFile(StrictModel):
     scenarios: Annotated[list[str | dict[str, Any]], Field(min_length=1)]
     planners: Annotated[list[Literal[TARGETS]], Field(min_length=1)] | None = None
     steering: Annotated[list[SteeringName], Field(min_length=1)] | None = None
-    parameters: dict[str, Annotated[list[Any], Field(min_length=1)] | Range] = Field(
-        default_factory=dict)
+    parameters: dict[str, Axis | Range] = Field(default_factory=dict)
     sample: Sample | None = None
-    seeds: Annotated[list[Seed], Field(min_length=1)] = Field(default_factory=lambda: [0])
+    seeds: Annotated[list[Seed], Field(min_length=1, max_length=MAX_RUNS)] = Field(
+        default_factory=lambda: [0])
     budget: Budget | None = None
 
     @field_validator("seeds", mode="before")
@@ -121,8 +128,8 @@ class StudyFile(StrictModel):
     def _count(cls, seeds: Any) -> Any:
         """``seeds: N`` means 0..N-1."""
         if isinstance(seeds, int) and not isinstance(seeds, bool):
-            if seeds < 1:
-                raise ValueError(f"a count of seeds is at least 1, got {seeds}")
+            if not 1 <= seeds <= MAX_RUNS:
+                raise ValueError(f"a count of seeds is 1 to {MAX_RUNS}, got {seeds}")
             return list(range(seeds))
         return seeds
 
@@ -202,6 +209,25 @@ class StudyFile(StrictModel):
                 raise ValueError(f"parameters.{key}: a range needs 'sample' (random points); "
                                  f"give a list of values for the grid")
         return self
+
+    @model_validator(mode="after")
+    def _bounded(self) -> StudyFile:
+        if self.size() > MAX_RUNS:
+            raise ValueError(self.too_many(MAX_RUNS))
+        return self
+
+    def size(self) -> int:
+        """The runs the study expands to at most (fewer where a planner ignores a parameter),
+        counted from the sizes of its axes."""
+        points = self.sample.n if self.sample is not None else math.prod(
+            len(v) for v in self.parameters.values())
+        budgets = len(self.budget.points()) if self.budget is not None else 1
+        return (len(self.scenarios) * len(self.planners or [None])
+                * len(self.steering or [None]) * points * budgets * len(self.seeds))
+
+    def too_many(self, cap: int) -> str:
+        return (f"this study expands to {self.size():,} runs (scenarios × planners × steering "
+                f"× parameter points × budgets × seeds); at most {cap:,}")
 
     def points(self) -> list[dict]:
         """The parameter points: the grid's, or ``sample.n`` random ones."""
@@ -284,10 +310,11 @@ def _has(planner_name: str, point: dict) -> dict:
 
 
 def parse_study(data: Any, text: str, resolve: Callable[[Any], planner.Scenario],
-                origin: str = "") -> Study:
+                origin: str = "", max_runs: int = MAX_RUNS) -> Study:
     """Validate and expand a decoded study; ``resolve`` turns an entry of ``scenarios`` (a
     name, a path, an id, an object) into a `planner.Scenario` or raises ScenarioError.
-    Raises StudyError naming the key, led by ``origin`` (the file) when given."""
+    Raises StudyError naming the key, led by ``origin`` (the file) when given, and refuses a
+    study of more than ``max_runs`` runs before expanding it."""
     lead = f"{origin}: " if origin else ""
     if not isinstance(data, dict):
         raise StudyError(f"{lead}a study is a mapping of keys, got {type(data).__name__}")
@@ -295,6 +322,8 @@ def parse_study(data: Any, text: str, resolve: Callable[[Any], planner.Scenario]
         spec = StudyFile.model_validate(data)
     except ValidationError as exc:
         raise StudyError(f"{lead}{describe(exc)}") from None
+    if spec.size() > max_runs:
+        raise StudyError(f"{lead}{spec.too_many(max_runs)}")
     scenarios = {}
     for i, source in enumerate(spec.scenarios):
         try:
