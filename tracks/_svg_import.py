@@ -80,11 +80,26 @@ class _SafeParser(DefusedXMLParser):
             super().defused_start_doctype_decl(name, sysid, pubid, has_internal_subset)
 
 
+class _CountingBuilder(ET.TreeBuilder):
+    """Stops the parse at the element after ``_MAX_WALKED``: no document needs more, and a few
+    megabytes of empty groups would otherwise take seconds to build."""
+
+    def __init__(self, name: str) -> None:
+        super().__init__()
+        self.name, self.count = name, 0
+
+    def start(self, tag, attrs):
+        self.count += 1
+        if self.count > _MAX_WALKED:
+            raise TrackError(f"{self.name}: more than {_MAX_WALKED} elements")
+        return super().start(tag, attrs)
+
+
 def parse_document(source: Source) -> ET.Element:
     """The root <svg> element, parsed without DTD subsets, entities or external references."""
     data, name = read_source(source)
     try:
-        parser = _SafeParser(target=ET.TreeBuilder(), forbid_dtd=True)
+        parser = _SafeParser(target=_CountingBuilder(name), forbid_dtd=True)
         parser.feed(data)
         root = parser.close()
     except defusedxml.DefusedXmlException as exc:
@@ -135,7 +150,8 @@ class _Walker:
         if props.get("display") == "none":
             return
         props.pop("display", None)
-        matrix = matrix @ parse_transform(elem.attrib.get("transform"))
+        if "transform" in elem.attrib:
+            matrix = matrix @ parse_transform(elem.attrib["transform"])
         if tag == "use":
             self._use(elem, matrix, props, uses, depth)
         elif tag in _CONTAINERS or (tag == "symbol" and clone is not None):

@@ -9,14 +9,12 @@ import io
 from fastapi import APIRouter, HTTPException, Request, Response
 
 from app.server.fair_queue import client_of
-from app.server.models import JobCreated, JobRequest, JobStatus
+from app.server.models import MAX_RUNS, JobCreated, JobRequest, JobStatus
 from app.server.routes_plan import plan_options
 from app.server.routes_scenarios import resolve
 from planner import ScenarioError
 
 router = APIRouter(tags=["jobs"])
-
-MAX_RUNS = 10_000
 
 
 @router.post("/jobs", response_model=JobCreated, status_code=202)

@@ -19,7 +19,7 @@ from pydantic import BaseModel
 import planner
 import tracks
 from app.server.fair_queue import client_of
-from app.server.routes_jobs import MAX_RUNS
+from app.server.models import MAX_RUNS
 from app.server.routes_scenarios import stored_scenario
 from app.study.report import write_report
 from app.study.results import TABLES, runs_csv
