@@ -50,9 +50,20 @@ NEAREST_BUCKETS = 256  # nearest's queue: half-cell buckets, the last one takes 
 # late polishes, a doubling apart, are few (earlier ones would slow the first 0.1 s).
 BLOCKS_FROM = 8192
 # Counter indices; POLISH_AT: the iteration at which the best path is next polished;
-# POLISHED: the best cost the last polish left, in micrometres; POLISHED_AT: its iteration.
+# POLISHED: the best cost the last polish left, in micrometres; POLISHED_AT: its iteration;
+# POLISH_EVALS: the clearance evaluations polishing has spent (of EVALS, all of them).
 (N, NGOAL, ITER, CHECKS, BEST, REWIRES, EVALS, IMPROVED, REFUSED, POLISH_AT, POLISHED,
- POLISHED_AT, NCOUNTERS) = range(13)
+ POLISHED_AT, POLISH_EVALS, NCOUNTERS) = range(14)
+# Polishing may spend at most this share of a run's clearance evaluations, counted (not
+# timed), so that a seed's run is the same on any machine; its share of the time stays under
+# a quarter (`planner.rrt.Result.polish_s` measures it).
+POLISH_SHARE = 0.2
+# ... beyond a first few thousand evaluations, which the first polishes of a short run may spend
+# whatever the search has spent so far (at the first solution that can be a few dozen).
+POLISH_FREE = 5000
+# What `iterate` returns: the batch ran; the tree is full (grow it and call again); a polish
+# is due (call `polish`, then `iterate` for the rest of the batch).
+RAN, FULL, POLISH_DUE = range(3)
 # Event row columns (only written when the event buffers are non-empty); EV_XN..EV_THN: where
 # Steer ended, x_new whether the motion to it was free or not.
 EV_ITER, EV_XR, EV_YR, EV_THR, EV_NEAREST, EV_NEW, EV_PARENT, EV_NEAR_START, EV_NEAR_END, \
@@ -498,10 +509,38 @@ def chain(parent: np.ndarray, node: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, counter, ev) -> bool:
-    """Polish the best path (`planner._polish`) and, if that shortens it, add the polished
-    poses to the tree as a chain from the root: the tree stays exact and RRT* goes on from it.
-    Returns whether it added them."""
+def polish(tree: Tree, w: World, P: np.ndarray, ev) -> None:
+    """The polish `iterate` stopped for (POLISH_DUE), within what is left of polishing's share
+    of the run's clearance evaluations; the next one is due at twice the iterations."""
+    kinds = np.zeros(5, np.int8)
+    lens = np.zeros(5)
+    counter = np.zeros(1, np.int64)
+    tree.cnt[POLISH_AT] = 2 * tree.cnt[ITER]
+    if _polish_best(tree, w, P, kinds, lens, counter, ev, _polish_allowance(tree)):
+        _update_best(tree)
+    tree.cnt[POLISHED] = int(tree.cost[tree.cnt[BEST]] * 1e6)
+    tree.cnt[POLISHED_AT] = tree.cnt[ITER]
+    tree.cnt[EVALS] += counter[0]
+    tree.cnt[POLISH_EVALS] += counter[0]
+    if ev.rows.shape[0] > 0 and ev.cnt[0] > 0:  # the iteration it followed ends at its cost
+        ev.rows[ev.cnt[0] - 1, EV_BEST] = tree.cost[tree.cnt[BEST]]
+
+
+@njit(cache=True, inline="always")
+def _polish_allowance(tree: Tree) -> int:
+    """The clearance evaluations a polish may spend now and keep within POLISH_SHARE (and
+    POLISH_FREE)."""
+    search = tree.cnt[EVALS] - tree.cnt[POLISH_EVALS]
+    return (int(POLISH_SHARE / (1.0 - POLISH_SHARE) * search) + POLISH_FREE
+            - tree.cnt[POLISH_EVALS])
+
+
+@njit(cache=True)
+def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, counter, ev,
+                 limit: int) -> bool:
+    """Polish the best path (`planner._polish`, at most ``limit`` clearance evaluations) and,
+    if that shortens it, add the polished poses to the tree as a chain from the root: the tree
+    stays exact and RRT* goes on from it. Returns whether it added them."""
     nodes = chain(tree.parent, tree.cnt[BEST])
     n = nodes.shape[0]
     # Each pass at most doubles the edges: the chain must fit whatever polishing makes of it.
@@ -512,7 +551,7 @@ def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, counter, ev) 
     code = int(P[STEERING])
     goal = np.array([P[GX], P[GY], P[GTH], P[GPOS], P[GHEAD]])
     poses, length = polish_path(w, code, P[RHO], P[SPEED], poses, goal, kinds, lens, counter,
-                                tree.cnt[ITER] >= BLOCKS_FROM)
+                                tree.cnt[ITER] >= BLOCKS_FROM, limit)
     if length >= tree.cost[tree.cnt[BEST]] - 1e-9:
         return False
     parent = root
@@ -532,8 +571,8 @@ def _polish_due(tree: Tree) -> bool:
     """At the first solution, then at twice as many iterations each time; and sooner (after a
     quarter more iterations) when the tree's best path is 0.1 % shorter than the polished one:
     a tree path beating a polished one is most often another route, which polishing shortens
-    most."""
-    if tree.cnt[BEST] < 0:
+    most. Never while polishing has spent its share of the run's clearance evaluations."""
+    if tree.cnt[BEST] < 0 or _polish_allowance(tree) <= 0:
         return False
     if tree.cnt[ITER] >= tree.cnt[POLISH_AT]:
         return True
@@ -604,8 +643,9 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
 
 
 @njit(cache=True)
-def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> bool:
-    """Run up to ``n_iter`` iterations; returns False when the tree is full (grow and call again).
+def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int:
+    """Run up to ``n_iter`` iterations; returns RAN, FULL (grow the tree and call again) or
+    POLISH_DUE (call `polish`: apart, so that its time can be measured).
 
     Every iteration draws one sample, whether or not it adds a node (as OMPL counts them).
     """
@@ -618,9 +658,11 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
     counter = np.zeros(1, np.int64)
     timed = w.m_kind.shape[0] > 0
     code = int(P[STEERING])
+    status = RAN
     for _ in range(n_iter):
         if tree.cnt[N] >= tree.pose.shape[0]:
-            return False
+            status = FULL
+            break
         if P[STAR] == 0.0 and tree.cnt[BEST] >= 0:
             break  # RRT ends at its first solution, whatever the batch size
         tree.cnt[ITER] += 1
@@ -739,13 +781,13 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> boo
                 ev.cnt[2] += 1
         if changed:
             _update_best(tree)
-        if P[POLISH] > 0.0 and P[STAR] > 0.0 and not timed and _polish_due(tree):
-            tree.cnt[POLISH_AT] = 2 * tree.cnt[ITER]
-            if _polish_best(tree, w, P, kinds, lens, counter, ev):
-                _update_best(tree)
-            tree.cnt[POLISHED] = int(tree.cost[tree.cnt[BEST]] * 1e6)
-            tree.cnt[POLISHED_AT] = tree.cnt[ITER]
         if record:
             ev.rows[row, EV_BEST] = tree.cost[tree.cnt[BEST]] if tree.cnt[BEST] >= 0 else math.inf
+        if P[POLISH] > 0.0 and P[STAR] > 0.0 and not timed:
+            tree.cnt[EVALS] += counter[0]  # the allowance reads them
+            counter[0] = 0
+            if _polish_due(tree):
+                status = POLISH_DUE
+                break
     tree.cnt[EVALS] += counter[0]
-    return True
+    return status

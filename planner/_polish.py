@@ -57,17 +57,20 @@ def _free(w: World, code: int, a, b, rho: float, speed: float, kinds, lens, coun
 
 @njit(cache=True)
 def polish_path(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
-                goal: np.ndarray, kinds, lens, counter, blocks: bool):
+                goal: np.ndarray, kinds, lens, counter, blocks: bool, limit: int):
     """The path through ``poses`` ((n, 3)) shortened: (new poses, their length); with
     ``blocks``, each pass also shifts blocks of poses (`_shift_blocks`), which costs a polish
-    about twice as much."""
+    about twice as much. It stops between two rounds once ``counter`` has passed ``limit``
+    clearance evaluations: every step keeps the path free, so where it stops is a path."""
     for _ in range(PASSES):
         poses = _split(code, rho, poses, kinds, lens)
-        _descend(w, code, rho, speed, poses, goal, kinds, lens, counter)
+        _descend(w, code, rho, speed, poses, goal, kinds, lens, counter, limit)
         if blocks:
             for width in BLOCKS:
-                _shift_blocks(w, code, rho, speed, poses, width, kinds, lens, counter)
-            _descend(w, code, rho, speed, poses, goal, kinds, lens, counter)
+                _shift_blocks(w, code, rho, speed, poses, width, kinds, lens, counter, limit)
+            _descend(w, code, rho, speed, poses, goal, kinds, lens, counter, limit)
+        if counter[0] > limit:
+            break
         poses = _prune(w, code, rho, speed, poses, kinds, lens, counter)
     total = 0.0
     for i in range(poses.shape[0] - 1):
@@ -107,7 +110,7 @@ def _edges(code: int, poses: np.ndarray, rho: float) -> tuple[np.ndarray, float]
 
 @njit(cache=True)
 def _descend(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
-             goal: np.ndarray, kinds, lens, counter) -> None:
+             goal: np.ndarray, kinds, lens, counter, limit: int) -> None:
     """Coordinate descent on the inner poses and the end pose (within the goal), in place:
     each round moves every pose by the step that shortens its edges most and is free."""
     n = poses.shape[0]
@@ -120,6 +123,8 @@ def _descend(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
     new_a = np.empty(nm)
     new_b = np.empty(nm)
     for _ in range(ROUNDS):
+        if counter[0] > limit:
+            return
         for i in range(1, n):
             last = i == n - 1
             now = edge[i - 1] + (0.0 if last else edge[i])
@@ -153,7 +158,7 @@ def _descend(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
 
 @njit(cache=True)
 def _shift_blocks(w: World, code: int, rho: float, speed: float, poses: np.ndarray, width: int,
-                  kinds, lens, counter) -> None:
+                  kinds, lens, counter, limit: int) -> None:
     """Coordinate descent on blocks of ``width`` inner poses shifted together, in place. A
     path that bulges round an obstacle between poses too far apart for any one of them to move
     freely can move as a whole; a shift keeps the steered edges inside the block."""
@@ -166,6 +171,8 @@ def _shift_blocks(w: World, code: int, rho: float, speed: float, poses: np.ndarr
     b = np.empty(3)
     moved = np.empty((width, 3))
     for _ in range(ROUNDS):
+        if counter[0] > limit:
+            return
         for i in range(1, n - width):
             j = i + width - 1
             now = edge[i - 1] + edge[j]

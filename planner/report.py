@@ -33,6 +33,8 @@ class PlanReport(BaseModel):
     arrival_time_s: float | None = Field(None, description="with moving obstacles or timing "
                                                             "optimal")
     planning_time_s: float
+    polish_s: float = Field(description="of planning_time_s, spent polishing the best path "
+                                        "(at most a fifth of the run's clearance evaluations)")
     rewires: int
     refused_rewires: int = Field(description="rewires refused: the subtree would collide at "
                                              "its new arrival times")
@@ -63,7 +65,8 @@ def plan_report(result: Result, scenario_name: str, budget: dict) -> PlanReport:
         collision_checks=result.collision_checks, min_clearance_m=_clean(result.min_clearance_m),
         max_abs_curvature=_clean(result.max_abs_curvature),
         arrival_time_s=result.arrival_time_s if result.timed else None,
-        planning_time_s=result.planning_time_s, rewires=result.rewires,
+        planning_time_s=result.planning_time_s, polish_s=result.polish_s,
+        rewires=result.rewires,
         refused_rewires=result.refused_rewires,
         cost_over_time=[(round(t, 6), c, i) for t, c, i in result.cost_over_time], path=path,
         parameters={**result.options.model_dump(), **budget,

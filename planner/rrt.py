@@ -44,6 +44,7 @@ class Result:
     rewires: int
     refused_rewires: int
     planning_time_s: float
+    polish_s: float  # of the planning time, spent polishing the best path
     min_clearance_m: float | None
     max_abs_curvature: float | None
     cost_over_time: list[tuple[float, float, int]]  # (t_s, best cost, iteration) per improvement
@@ -119,6 +120,7 @@ class Planner:
         self._listeners: list[Callable[[TreeEvents], None]] = []
         self._clock = _Clock()
         self._compute_time = 0.0
+        self._polish_time = 0.0  # of it, polishing the best path
 
     # -- observation -------------------------------------------------------------------------
     def add_listener(self, listener: Callable[[TreeEvents], None]) -> None:
@@ -214,9 +216,14 @@ class Planner:
         target = done_before + iterations
         t0 = time.perf_counter()
         while self.iterations < target and not self.finished:
-            if not K.iterate(self._tree, self._world, self._P,
-                             target - self.iterations, events):
+            status = K.iterate(self._tree, self._world, self._P, target - self.iterations,
+                               events)
+            if status == K.FULL:
                 self._tree = K.grown(self._tree, 2 * self._tree.pose.shape[0])
+            elif status == K.POLISH_DUE:
+                started = time.perf_counter()
+                K.polish(self._tree, self._world, self._P, events)
+                self._polish_time += time.perf_counter() - started
         took = time.perf_counter() - t0
         self._compute_time += took
         self._note_progress(done_before, took)
@@ -376,7 +383,8 @@ class Planner:
             iterations=self.iterations, nodes=self.nodes,
             collision_checks=int(t.cnt[K.CHECKS]), clearance_evaluations=int(t.cnt[K.EVALS]),
             rewires=int(t.cnt[K.REWIRES]), refused_rewires=int(t.cnt[K.REFUSED]),
-            planning_time_s=self._compute_time, min_clearance_m=min_clear,
+            planning_time_s=self._compute_time, polish_s=self._polish_time,
+            min_clearance_m=min_clear,
             max_abs_curvature=float(np.abs(path[:, 3]).max()) if solved else None,
             cost_over_time=list(self._clock.cost_over_time), path=path,
             timed=self.problem.timed, options=self.options, length_m=self.best_cost)

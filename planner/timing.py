@@ -201,7 +201,7 @@ class TimeOptimalPlanner:
         results = [p.result() for p in self.planners]
         totals = {name: sum(getattr(r, name) for r in results) for name in (
             "iterations", "nodes", "collision_checks", "clearance_evaluations", "rewires",
-            "refused_rewires", "planning_time_s")}
+            "refused_rewires", "planning_time_s", "polish_s")}
         first = min((r.time_to_first_solution_s for r in results if r.solved), default=None)
         candidates = self.schedules()
         if not candidates:

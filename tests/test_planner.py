@@ -254,3 +254,25 @@ def test_polishing_finds_where_to_enter_the_goal_region(seed):
     unpolished = planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=3000,
                                seed=seed, polish=False)
     assert unpolished.cost > result.cost + 0.01
+
+
+def test_polishing_keeps_to_its_share_of_the_work_and_its_time_is_reported():
+    """Issue 31: polishing took over two thirds of a 1 s run on the stadium lap. Its budget is
+    counted in clearance evaluations (a seed's run is the same anywhere), and its time is
+    measured apart (`polish_s`)."""
+    import planner._kernel as K
+
+    problem = planner.compile_problem(planner.load_scenario("oval_track"))
+    run = planner.planner_for(problem, planner.PlanOptions(seed=1))
+    run.advance(None, 20_000)
+    cnt = run._tree.cnt
+    search = cnt[K.EVALS] - cnt[K.POLISH_EVALS]
+    assert 0 < cnt[K.POLISH_EVALS]
+    assert cnt[K.POLISH_EVALS] <= K.POLISH_SHARE / (1 - K.POLISH_SHARE) * search + K.POLISH_FREE
+    result = run.result()
+    assert 0.0 < result.polish_s < result.planning_time_s
+    again = planner.planner_for(problem, planner.PlanOptions(seed=1))
+    again.advance(None, 20_000)
+    assert again.result().cost == result.cost  # counted, not timed: the same run
+    off = planner.solve(problem, time_limit=None, iterations=2000, seed=1, polish=False)
+    assert off.polish_s == 0.0

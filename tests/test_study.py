@@ -76,10 +76,12 @@ def test_a_study_runs_its_grid_and_stores_the_numbers_plan_prints(study_file, tm
     with (default_out / "results.csv").open() as f:
         reader = csv.DictReader(f)
         assert tuple(reader.fieldnames)[:3] == ("id", "study", "scenario")
-        assert len(list(reader)) == 16
+        runs = list(reader)
+        assert len(runs) == 16
+        assert all(0.0 <= float(r["polish_s"]) < float(r["wall_s"]) for r in runs)
     check_report(default_out, ["open_field", "slalom"])
     with sqlite3.connect(default_out / "results.sqlite") as db:
-        assert db.execute("PRAGMA user_version").fetchone() == (2,)
+        assert db.execute("PRAGMA user_version").fetchone() == (3,)
         for run_id, cost in db.execute("SELECT id, cost FROM runs WHERE solved"):
             curve = [c for (c,) in db.execute("SELECT cost FROM cost_over_time WHERE run_id = ? "
                                               "ORDER BY iteration", (run_id,))]
@@ -388,7 +390,23 @@ def test_a_results_file_of_schema_1_gains_the_collision_split(tmp_path):
         columns = [r[1] for r in db.execute("PRAGMA table_info(sim_runs)")]
         assert {"collisions_moving", "collisions_at_rest"} <= set(columns)
         assert db.execute("SELECT reached, collisions_moving FROM sim_runs").fetchall() == [(1, None)]
-        assert db.execute("PRAGMA user_version").fetchone() == (2,)
+        assert db.execute("PRAGMA user_version").fetchone() == (3,)
+
+
+def test_a_results_file_of_schema_2_gains_polish_s(tmp_path):
+    """A planning study stored before polishing was timed is resumed, its rows kept."""
+    from app.study.results import _SCHEMA, Results
+
+    with sqlite3.connect(tmp_path / "results.sqlite") as db:
+        db.executescript(_SCHEMA.replace("polish_s REAL, ", "").replace(
+            "user_version = 3", "user_version = 2"))
+        db.execute("INSERT INTO runs (study, scenario, planner, steering, parameters, seed, "
+                   "solved, trackstar_version, finished_at) VALUES ('old', 'slalom', 'rrt', "
+                   "'dubins', '{}', 0, 1, '0', 'then')")
+    Results(tmp_path, "old", "plan", "name: old").close()
+    with sqlite3.connect(tmp_path / "results.sqlite") as db:
+        assert db.execute("SELECT solved, polish_s FROM runs").fetchall() == [(1, None)]
+        assert db.execute("PRAGMA user_version").fetchone() == (3,)
 
 
 def test_a_terminal_gets_a_progress_bar_even_one_that_reports_no_size(tmp_path):

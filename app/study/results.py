@@ -18,11 +18,13 @@ from pathlib import Path
 
 __all__ = ["COLUMNS", "TABLES", "Results", "StudyMismatch", "runs_csv"]
 
-SCHEMA_VERSION = 2  # 2: sim_runs splits collisions into the car's (moving) and at rest
+# 2: sim_runs splits collisions into the car's (moving) and at rest; 3: runs.polish_s
+SCHEMA_VERSION = 3
 KEY = ("scenario", "planner", "steering", "parameters", "budget_iterations", "budget_time_s",
        "seed")
 OUTCOME = ("solved", "cost", "time_to_first_solution_s", "iterations", "nodes",
-           "collision_checks", "min_clearance_m", "iterations_per_s", "wall_s", "error")
+           "collision_checks", "min_clearance_m", "iterations_per_s", "polish_s", "wall_s",
+           "error")
 SIM_KEY = ("scenario", "parameters", "seed")
 SIM_OUTCOME = ("reached", "collisions", "collisions_moving", "collisions_at_rest",
                "min_clearance_m", "time_to_goal_s", "cycle_p50_ms",
@@ -42,7 +44,7 @@ CREATE TABLE IF NOT EXISTS runs (
     steering TEXT NOT NULL, parameters TEXT NOT NULL, budget_iterations INTEGER,
     budget_time_s REAL, seed INTEGER NOT NULL, solved INTEGER, cost REAL,
     time_to_first_solution_s REAL, iterations INTEGER, nodes INTEGER, collision_checks INTEGER,
-    min_clearance_m REAL, iterations_per_s REAL, wall_s REAL, error TEXT,
+    min_clearance_m REAL, iterations_per_s REAL, polish_s REAL, wall_s REAL, error TEXT,
     trackstar_version TEXT NOT NULL, finished_at TEXT NOT NULL);
 CREATE UNIQUE INDEX IF NOT EXISTS runs_key ON runs (study, scenario, planner, steering,
     parameters, IFNULL(budget_iterations, -1), IFNULL(budget_time_s, -1), seed);
@@ -132,6 +134,9 @@ def _migrate(db: sqlite3.Connection) -> None:
     if has_sim and old < 2:
         for column in ("collisions_moving", "collisions_at_rest"):
             db.execute(f"ALTER TABLE sim_runs ADD COLUMN {column} INTEGER")
+    has_runs = db.execute("SELECT 1 FROM sqlite_master WHERE name = 'runs'").fetchone()
+    if has_runs and old < 3:
+        db.execute("ALTER TABLE runs ADD COLUMN polish_s REAL")
 
 
 def _now() -> str:

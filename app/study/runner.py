@@ -66,7 +66,7 @@ def _plan(scenario: planner.Scenario, run: Run, max_time: float | None,
         "time_to_first_solution_s": report.time_to_first_solution_s,
         "iterations": report.iterations, "nodes": report.nodes,
         "collision_checks": report.collision_checks, "min_clearance_m": report.min_clearance_m,
-        "iterations_per_s": rate}
+        "iterations_per_s": rate, "polish_s": report.polish_s}
     return outcome, [(i, t, cost) for t, cost, i in report.cost_over_time]
 
 
