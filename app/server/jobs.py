@@ -4,8 +4,9 @@ The pool is sized to the machine plus one worker and started as soon as the serv
 are loaded (`app.kernels`; requests wait until then); each worker loads the planner's compiled
 kernels once (`warm_up` as its initializer), so no request pays for it. Every call takes a slot
 of the `FairQueue` first: plans go ahead of batch work and always find the extra worker free
-of it, and the runs of jobs, studies and simulations take turns client by client. At shutdown the workers are terminated (a plan may have up to --max-plan-s
-left) and unfinished jobs are marked failed, so a restart shows what was interrupted.
+of it, and the runs of jobs, studies and simulations take turns client by client. At shutdown
+the workers are terminated (a plan may have up to --max-plan-s left) and unfinished jobs are
+marked failed, so a restart shows what was interrupted.
 
 Cancelling the task that awaits a call (a client gone, DELETE of its job, a simulation past
 the server's wall-time cap) asks the worker running it to stop, through the call's `StopFlag`:
