@@ -28,6 +28,17 @@ async def _order(queue: FairQueue, calls) -> list[str]:
     return got
 
 
+def _holders(queue: FairQueue, ticket, n: int) -> tuple[list[asyncio.Task], asyncio.Event]:
+    """``n`` tasks that each take a slot with ``ticket`` and hold it until the event is set."""
+    release = asyncio.Event()
+
+    async def hold():
+        async with queue.slot(ticket):
+            await release.wait()
+
+    return [asyncio.create_task(hold()) for _ in range(n)], release
+
+
 def test_batch_runs_take_turns_by_client_and_leave_a_worker_to_plans():
     async def main():
         queue = FairQueue(workers=1)  # two slots: one for batch work, one kept for plans
@@ -43,14 +54,7 @@ def test_batch_runs_take_turns_by_client_and_leave_a_worker_to_plans():
 def test_a_plan_gets_a_worker_at_once_while_batch_work_floods_the_pool():
     async def main():
         queue = FairQueue(workers=2)
-        flood = queue.admit("10.0.0.1", 50)
-        release = asyncio.Event()
-
-        async def batch():
-            async with queue.slot(flood):
-                await release.wait()
-
-        tasks = [asyncio.create_task(batch()) for _ in range(50)]
+        tasks, release = _holders(queue, queue.admit("10.0.0.1", 50), 50)
         await asyncio.sleep(0.01)
         assert queue.batch_busy == 2 and queue.busy == 2  # the third worker stays free
         async with asyncio.timeout(0.5):
@@ -90,13 +94,7 @@ def test_a_cancelled_waiter_leaves_the_queue_and_a_closed_ticket_frees_its_runs(
     async def main():
         queue = FairQueue(workers=1)
         ticket = queue.admit("a", 3)
-        hold = asyncio.Event()
-
-        async def one():
-            async with queue.slot(ticket):
-                await hold.wait()
-
-        first, second = asyncio.create_task(one()), asyncio.create_task(one())
+        (first, second), _ = _holders(queue, ticket, 2)
         await asyncio.sleep(0.01)
         second.cancel()  # waiting for a slot
         first.cancel()  # holding one
