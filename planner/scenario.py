@@ -273,6 +273,9 @@ class Prediction(StrictModel):
         None, description="m/s: the most a sensed velocity is off")
     horizon: Annotated[float, Field(ge=0, le=MAX_HORIZON_S)] | None = Field(
         None, description="s of look-ahead over which the predictions widen; held beyond")
+    along_track: bool = Field(
+        False, description="the movers keep to the track: predict each along its centreline "
+                           "at its sensed speed along it, not straight on (needs a 'track')")
 
 
 class Scenario(StrictModel):
@@ -298,6 +301,8 @@ class Scenario(StrictModel):
             if not (xmin < xmax and ymin < ymax):
                 raise ValueError(f"bounds must be [xmin, ymin, xmax, ymax] with min < max, "
                                  f"got {list(self.bounds)}")
+        if self.prediction.along_track and self.track is None:
+            raise ValueError("prediction.along_track needs a 'track'")
         for i, ob in enumerate(self.obstacles):
             if ob.motion and ob.motion.follow_track and self.track is None:
                 raise ValueError(f"obstacles[{i}].motion.follow_track needs a 'track'")

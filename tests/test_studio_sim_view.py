@@ -14,7 +14,8 @@ from conftest import scenario_dict
 import planner
 from app.studio._clock import SceneClock
 from app.studio._scene import yaw_wxyz
-from app.studio._sim_view import EDGE_PIECES, SimView
+from app.studio._sim_view import EDGE_PIECES, PREDICT_S, SimView
+from planner.sim.sensing import mover_index, true_offsets
 
 
 @pytest.fixture
@@ -90,3 +91,25 @@ def test_a_collision_and_a_stall_are_marked_where_and_when_with_their_cause(view
     view.start(planner.compile_problem(planner.load_scenario("gate")), settings)
     assert "ghost2" not in view._handles and "grown2_0" not in view._handles
     view.stop()
+
+
+def test_movers_that_keep_to_the_track_are_drawn_predicted_along_it(view):
+    """thesis_half_lap predicts its disc along the track (prediction.along_track): the drawn
+    prediction bends with the track, onto where the disc will truly be."""
+    problem = planner.compile_problem(planner.load_scenario("thesis_half_lap"))
+    view.start(problem, dataclasses.replace(view.settings(), realtime=False, duration=3.0))
+    run = view.run
+    deadline = time.monotonic() + 60
+    while run.running and time.monotonic() < deadline:
+        time.sleep(0.05)
+    view.tick()
+    f = view._shown["frame"]
+    line = view._handles["prediction"].points[:, :, :2]
+    ahead = np.vstack([line[:, 0], line[-1:, 1]])  # the drawn points, from now on
+    taus = np.linspace(0.0, PREDICT_S, len(ahead))
+    movers = mover_index(problem.scenario)
+    truth = (np.asarray(problem.scenario.obstacles[1].center)
+             + true_offsets(problem.world, movers, f.t + taus)[:, 1])
+    assert np.linalg.norm(ahead - truth, axis=1).max() < 0.05
+    turned = np.diff(np.unwrap(np.arctan2(*np.diff(ahead, axis=0).T[::-1])))
+    assert abs(turned.sum()) > 0.5  # it bends with the track (radians over the 2 s drawn)

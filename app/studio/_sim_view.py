@@ -5,8 +5,9 @@ A run goes on its own thread (`simulate(..., realtime=True)`); its observer keep
 since a planner's arrays are only safe to read on the thread that runs it. The session's ticker
 calls `SimView.tick`, which draws the latest state: the car; the movers where they truly are
 (the stage's own obstacles, the scene clock set to the simulation's time); where the car
-believes they are (translucent ghosts: the last sensing extrapolated at constant velocity, with
-a line to where it predicts them ``PREDICT_S`` later) and their grown predictions (issue 30:
+believes they are (translucent ghosts: the last sensing carried on as the run predicts it, at
+constant velocity or along the track's lanes, with a line along where it predicts them over the
+next ``PREDICT_S``) and their grown predictions (issue 30:
 the shape grown by the run's uncertainty at look-aheads ``LOOK_AHEAD_S``, fading with τ; none
 for a mover whose timetable the car is told, `motion.known`); the
 committed path, the tree, Soll/Ist steering and lateral error plots, a safety timeline (speed,
@@ -40,6 +41,7 @@ from app.studio._scene import (
 )
 from planner.sim import SimSettings
 from planner.sim.control import CONTROLLERS
+from planner.sim.predict import Lanes, believed_offsets
 from planner.sim.run import GUARD_CODES, Frame, simulate
 from planner.sim.sensing import known_motions, mover_index
 from planner.validation import describe
@@ -52,6 +54,7 @@ PATH_S = 0.2  # s between committed-path updates (a new one arrives with every c
 WINDOW_S = 20.0  # s of history in the plots
 PLOT_POINTS = 400
 PREDICT_S = 2.0  # s of predicted motion drawn ahead of each believed obstacle
+PREDICT_POINTS = 9  # points of that line (a lane prediction bends with the track)
 EDGE_PIECES = 4  # straight pieces per drawn tree edge
 GHOST_RGB = (90, 200, 255)
 GHOST_Z = Z["obstacle"] + 0.001
@@ -247,6 +250,7 @@ class SimView:
         """A new run of ``problem`` (the caller keeps the planner's own run out of its way)."""
         self.clear()
         self._uncertainty = settings.uncertainty(problem.scenario)
+        self._lanes = Lanes.of(problem.scenario)
         self._draw_static(problem)
         self.clock.reach(settings.duration)
         self.run = _Run(problem, settings)
@@ -344,16 +348,18 @@ class SimView:
         car.position, car.wxyz = (x, y, 0.0), yaw_wxyz(th)
         self.clock.set(f.t)  # the stage draws the true movers at the scene clock
         lines = []
-        for i, c in self._centres.items():
-            m, sensing = self._movers[i], f.sensing
-            if sensing is None:
-                continue
-            sensed, vel = sensing.offsets[m], sensing.velocities[m]
-            now = sensed + vel * (f.t - sensing.t)
-            self._handles[f"ghost{i}"].position = (*(c + now), 0.0)
-            for k, tau in enumerate(LOOK_AHEAD_S):
-                self._handles[f"grown{i}_{k}"].position = (*(c + now + vel * tau), 0.0)
-            lines.append([c + sensed, c + now + vel * PREDICT_S])
+        sensing = f.sensing
+        if sensing is not None and self._centres:
+            taus = np.concatenate([[0.0], LOOK_AHEAD_S,
+                                   np.linspace(0.0, PREDICT_S, PREDICT_POINTS)])
+            believed = believed_offsets(sensing, f.t, taus, self._lanes)
+            for i, c in self._centres.items():
+                at = c + believed[:, self._movers[i]]
+                self._handles[f"ghost{i}"].position = (*at[0], 0.0)
+                for k in range(len(LOOK_AHEAD_S)):
+                    self._handles[f"grown{i}_{k}"].position = (*at[1 + k], 0.0)
+                ahead = at[1 + len(LOOK_AHEAD_S):]
+                lines.extend(np.stack([ahead[:-1], ahead[1:]], axis=1))
         seg = np.zeros((len(lines), 2, 3), np.float32)
         if lines:
             seg[:, :, :2], seg[:, :, 2] = lines, GHOST_Z

@@ -16,6 +16,12 @@ speed plus the fastest growth, since the exact motion checks rely on it.
 
 A mover whose timetable the car is told (`motion.known`: a door, a barrier, a train) keeps its
 true motion, shifted into planner time, with no growth.
+
+On a track whose movers keep to their lanes (`prediction.along_track`), constant velocity is
+wrong in every bend: it sends a mover off along the tangent, so one that follows the car round
+a curve is believed to leave. `Lanes` predicts each mover along the centreline instead, at its
+sensed speed along it, at the distance beside the centreline where it was sensed; the growth is
+the same.
 """
 
 from __future__ import annotations
@@ -26,11 +32,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from planner._world import VELOCITY, VMAX_OBS, WAYPOINTS, World
-from planner.sim.sensing import Sensing
+from planner.problem import resolve_track
+from planner.sim.sensing import Sensing, motion_anchors
 
-__all__ = ["HORIZON_S", "Uncertainty", "predicted_world"]
+__all__ = ["HORIZON_S", "Lanes", "Uncertainty", "believed_offsets", "predicted_world"]
 
 HORIZON_S = 1.0e4  # the predicted straight line is long enough for any run
+LANE_SPACING = 0.05  # m between the centreline samples a lane prediction follows
+LANE_STEP = 0.1  # m of arc between a lane prediction's waypoints (chord error ≤ 2.5 mm at ρ 0.5 m)
+LANE_HORIZON_S = 30.0  # s of lane prediction; a mover is believed to stand beyond (re-predicted
+# every cycle, and far beyond any commitment the guard checks)
 
 
 @dataclass(frozen=True)
@@ -59,25 +70,97 @@ class Uncertainty:
         return self.speed_error + self.accel * self.horizon
 
 
+@dataclass(frozen=True)
+class Lanes:
+    """A closed or open track's centreline, for predicting movers that keep to it."""
+
+    s: np.ndarray  # (k,) arc length of the samples
+    xy: np.ndarray  # (k, 2) centreline samples
+    normal: np.ndarray  # (k, 2) unit normals, pointing left of the centreline's direction
+    closed: bool
+    anchors: np.ndarray  # (n_motions, 2) each mover's reference point at offset 0
+
+    @classmethod
+    def of(cls, scenario, load_track=None) -> Lanes | None:
+        """The lanes of the scenario's track when its movers keep to them
+        (`prediction.along_track`), else None; ``load_track`` as for `resolve_track`."""
+        if not scenario.prediction.along_track:
+            return None
+        track = resolve_track(scenario, load_track)
+        prof = track.sample(spacing=LANE_SPACING)
+        return cls(prof.s, np.column_stack([prof.x, prof.y]),
+                   np.column_stack([-np.sin(prof.heading), np.cos(prof.heading)]),
+                   track.closed, motion_anchors(scenario))
+
+    def advance(self, offsets: np.ndarray, velocities: np.ndarray, lag: np.ndarray) -> np.ndarray:
+        """(len(lag), n, 2): the offsets of movers sensed at ``offsets`` with ``velocities``,
+        each driven ``lag`` seconds along the centreline at its speed along it, at the
+        distance beside it where it was sensed (exactly there at lag 0)."""
+        p = self.anchors + offsets
+        a, ab = self.xy[:-1], np.diff(self.xy, axis=0)
+        ab2 = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-18)
+        w = np.clip(np.einsum("mkj,kj->mk", p[:, None] - a, ab) / ab2, 0.0, 1.0)
+        near = np.argmin(np.sum((a + w[..., None] * ab - p[:, None]) ** 2, axis=2), axis=1)
+        rows = np.arange(len(p))
+        s0 = self.s[near] + w[rows, near] * np.sqrt(ab2[near])
+        along = np.einsum("mj,mj->m", velocities, ab[near]) / np.sqrt(ab2[near])
+        s = s0 + along * np.asarray(lag, dtype=float)[:, None]
+        length = self.s[-1]
+        s = np.mod(s, length) if self.closed else np.clip(s, 0.0, length)
+        at = self._point(s0[None], 0.0)[0]
+        beside = np.einsum("mj,mj->m", p - at, self._normal(s0[None])[0])
+        moved = self._point(s, beside)
+        return moved + (p - self._point(s0[None], beside)[0]) - self.anchors
+
+    def _normal(self, s: np.ndarray) -> np.ndarray:
+        n = np.stack([np.interp(s, self.s, self.normal[:, k]) for k in (0, 1)], axis=-1)
+        return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+    def _point(self, s: np.ndarray, beside) -> np.ndarray:
+        c = np.stack([np.interp(s, self.s, self.xy[:, k]) for k in (0, 1)], axis=-1)
+        return c + np.asarray(beside)[..., None] * self._normal(s)
+
+
+def believed_offsets(sensing: Sensing, t0: float, taus, lanes: Lanes | None = None) -> np.ndarray:
+    """(len(taus), n_motions, 2): where the car believes each mover is (the centre of its grown
+    shape) at absolute times ``t0 + taus``: on from its sensing at constant velocity, or along
+    ``lanes``."""
+    taus = np.asarray(taus, dtype=float)
+    if lanes is None:
+        now = sensing.offsets + sensing.velocities * (t0 - sensing.t)
+        return now + sensing.velocities * taus[:, None, None]
+    return lanes.advance(sensing.offsets, sensing.velocities, (t0 - sensing.t) + taus)
+
+
 def predicted_world(base: World, sensing: Sensing, t0: float,
-                    uncertainty: Uncertainty = Uncertainty(), known=None) -> World:
-    """``base`` with its movers replaced by the grown constant-velocity prediction from
-    ``sensing``, in a planner time that starts at absolute time ``t0``; the movers where the
-    boolean ``known`` (per motion, world order) is true keep their true motion."""
+                    uncertainty: Uncertainty = Uncertainty(), known=None,
+                    lanes: Lanes | None = None) -> World:
+    """``base`` with its movers replaced by the grown prediction from ``sensing`` (at constant
+    velocity, or along ``lanes``), in a planner time that starts at absolute time ``t0``; the
+    movers where the boolean ``known`` (per motion, world order) is true keep their true
+    motion."""
     n = sensing.offsets.shape[0]
     if n == 0:
         return base
     known = np.zeros(n, bool) if known is None else np.asarray(known, bool)
-    start = sensing.offsets + sensing.velocities * (t0 - sensing.t)
-    wps = [_timetable(base, m, t0) if known[m] else
-           np.array([[0.0, *start[m]], [HORIZON_S, *(start[m] + sensing.velocities[m] * HORIZON_S)]])
+    if lanes is None:
+        taus = np.array([0.0, HORIZON_S])
+    else:
+        fastest = float(np.hypot(*sensing.velocities.T).max())
+        taus = np.linspace(0.0, LANE_HORIZON_S,
+                           int(np.clip(fastest * LANE_HORIZON_S / LANE_STEP, 1, 2000)) + 1)
+    believed = believed_offsets(sensing, t0, taus, lanes)
+    wps = [_timetable(base, m, t0) if known[m] else np.column_stack([taus, believed[:, m]])
            for m in range(n)]
     grow = np.zeros((n, 5))
     grow[~known] = (0.0, uncertainty.speed_error, uncertainty.accel, t0 - sensing.t,
                     uncertainty.horizon)
     geo = base.geo.copy()
-    predicted = np.hypot(*sensing.velocities[~known].T)
-    geo[VMAX_OBS] = max(float(predicted.max()) + uncertainty.rate if len(predicted) else 0.0,
+    if lanes is None:
+        speeds = np.hypot(*sensing.velocities[~known].T)
+    else:  # the fastest chord, as fast as the mover beside a bend's outside
+        speeds = np.hypot(*np.diff(believed[:, ~known], axis=0).T) / np.diff(taus)[None, :]
+    geo[VMAX_OBS] = max(float(speeds.max()) + uncertainty.rate if speeds.size else 0.0,
                         base.geo[VMAX_OBS] if known.any() else 0.0)
     return base._replace(geo=geo, m_kind=np.full(n, WAYPOINTS, np.int64),
                          m_vel=np.zeros((n, 2)),

@@ -23,7 +23,7 @@ from planner.options import PlanOptions
 from planner.problem import Problem
 from planner.rrt import Planner
 from planner.sim.control import Reference
-from planner.sim.predict import Uncertainty, predicted_world
+from planner.sim.predict import Lanes, Uncertainty, predicted_world
 from planner.sim.sensing import Sensing, known_motions
 from planner.timing import fastest_schedule
 
@@ -62,7 +62,8 @@ class Replanner:
 
     def __init__(self, problem: Problem, options: PlanOptions, *, seed: int,
                  budget_s: float | None, iterations: int | None, margin: float,
-                 uncertainty: Uncertainty = Uncertainty(), horizon_s: float = 4.0) -> None:
+                 uncertainty: Uncertainty = Uncertainty(), lanes: Lanes | None = None,
+                 horizon_s: float = 4.0) -> None:
         self.problem = problem
         self.options = options.resolved(problem)
         self.seed = seed
@@ -71,6 +72,7 @@ class Replanner:
         self.margin = margin
         self.uncertainty = uncertainty
         self.known = known_motions(problem.scenario)
+        self.lanes = lanes
         self.horizon_s = horizon_s
         self.planner: Planner | None = None
         self.attached = False  # the reference from root_s on is the planner's best path
@@ -95,7 +97,7 @@ class Replanner:
         commit = max(v, 0.0) * lead_s + 0.5 * a * lead_s ** 2 if v > 1e-9 else 0.0
         root, anchor, skip, s_c = self._commit_point(pose, s_now, commit)
         believed = predicted_world(self.problem.world, sensing, t + lead_s, self.uncertainty,
-                                   self.known)
+                                   self.known, self.lanes)
         plan_world = inflated(believed, self.margin)
         if clearance(plan_world, root[0], root[1], 0.0) <= 0.0:
             plan_world = believed  # already inside the margin: plan with the bare disc

@@ -28,7 +28,7 @@ from planner.sim.fsm.runtime import Behaviour
 from planner.sim.guard import BACK_OFF, FOLLOW, STAND, UNSTICK_S, Decision, guard
 from planner.sim.laps import LapCounter, require_track
 from planner.sim.metrics import AT_REST, MOVING, collision_runs, contacts, cycle_stats
-from planner.sim.predict import Uncertainty, predicted_world
+from planner.sim.predict import Lanes, Uncertainty, predicted_world
 from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
 from planner.sim.sensing import Sensing, known_motions, mover_index, sense, true_offsets
@@ -71,7 +71,7 @@ class SimSettings:
         pick = {name: value for name, value in (
             ("accel", self.predict_accel), ("speed_error", self.predict_speed_error),
             ("horizon", self.predict_horizon)) if value is not None}
-        given = {k: v for k, v in (p.model_dump() if p is not None else {}).items()
+        given = {k: v for k, v in (p.model_dump(exclude={"along_track"}) if p is not None else {}).items()
                  if v is not None}
         return Uncertainty(**{**given, **pick})
 
@@ -165,13 +165,13 @@ def _state(decision: Decision | None, waiting: bool) -> str:
 
 
 def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertainty,
-            s: SimSettings,
+            lanes: Lanes | None, s: SimSettings,
             limits: Limits, state, ref: Reference | None, stop_s: float, cruise: float,
             commit: float, stuck: bool, done_s: float) -> Decision:
     """The guard's decision at a cycle's start, in the world the car believes in now (grown
     predictions, the planning margin; the bare car where it already is inside the margin)."""
     believed = predicted_world(problem.world, sensing, t, uncertainty,
-                               known_motions(problem.scenario))
+                               known_motions(problem.scenario), lanes)
     margin = GUARD_MARGIN * s.margin
     margin = margin if clearance(believed, state[0], state[1], 0.0) > margin else 0.0
     i = ref.project(state[0], state[1])[0] if ref is not None else 0
@@ -215,6 +215,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     rng = np.random.default_rng(s.seed)
     fixed = s.fixed_latency_ms / 1000.0 if s.fixed_latency_ms is not None else None
     uncertainty = s.uncertainty(scenario)
+    lanes = Lanes.of(scenario, load_track)
     goal = problem.goal_region()
     def new_replanner() -> Replanner:
         # No polishing: a cycle's budget is a few milliseconds, and the next cycle replans.
@@ -223,7 +224,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                          seed=s.seed,
                          budget_s=s.budget_share / s.rate,
                          iterations=s.iterations if fixed is not None else None,
-                         margin=s.margin, uncertainty=uncertainty)
+                         margin=s.margin, uncertainty=uncertainty, lanes=lanes)
 
     fsm = Behaviour(behaviour, problem.world, limits.wheelbase, dt) if behaviour else None
     # FollowTrack caps its own speed; timing optimal drives as fast as the car may.
@@ -282,7 +283,8 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                 if planned or (abs(v) > 1e-9 and not backing):
                     planless_since = t  # not stuck: waiting by plan, or driving
                     backed_off = backed_off and v <= 0.0
-                decision = _decide(problem, sensing, t, uncertainty, s, limits, (*est, v, steer),
+                decision = _decide(problem, sensing, t, uncertainty, lanes, s, limits,
+                                   (*est, v, steer),
                                    ref, stop_s, cruise, lead,
                                    backing or (not backed_off
                                                and t - planless_since >= STUCK_S), done_s)

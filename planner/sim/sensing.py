@@ -12,7 +12,7 @@ import numpy as np
 
 from planner._world import VELOCITY, World
 
-__all__ = ["Sensing", "known_motions", "mover_index", "sense", "true_offsets"]
+__all__ = ["Sensing", "known_motions", "motion_anchors", "mover_index", "sense", "true_offsets"]
 
 
 def mover_index(scenario) -> np.ndarray:
@@ -28,6 +28,14 @@ def known_motions(scenario) -> np.ndarray:
     """Per motion (world order), whether the car is told its timetable (`motion.known`)."""
     return np.array([ob.motion.known for ob in scenario.obstacles if ob.motion is not None],
                     dtype=bool)
+
+
+def motion_anchors(scenario) -> np.ndarray:
+    """(n_motions, 2), world order: the point of each mover that its offset moves from (a
+    circle's or box's centre, a polygon's mean vertex)."""
+    return np.array([np.mean(ob.points, axis=0) if ob.type == "polygon"
+                     else ob.center for ob in scenario.obstacles if ob.motion is not None],
+                    dtype=float).reshape(-1, 2)
 
 
 def true_offsets(world: World, movers: np.ndarray, times) -> np.ndarray:
