@@ -145,11 +145,12 @@ def test_a_plan_answers_at_once_while_jobs_flood_the_server_from_the_same_addres
 def test_too_many_queued_runs_from_one_client_get_429_with_retry_after(server):
     """A client may have 10 000 runs queued or running; beyond, a job waits its turn outside
     (nothing is stored or started), and the client is told when to come back."""
-    body = {"scenarios": [scenario_dict("slalom")], "parameters": [{"iterations": 1}],
-            "seeds": list(range(10_000))}
+    body = {"scenarios": [scenario_dict("slalom")], "parameters": [{"iterations": 2000}],
+            "seeds": list(range(10_000))}  # runs of tens of ms: the job outlasts the test's posts
     first = server.client.post("/jobs", json=body)
     assert first.status_code == 202
-    again = server.client.post("/jobs", json={**body, "seeds": [0]})
+    # 1 000 more: refused until 1 000 of the first job's runs (a minute's work) are done.
+    again = server.client.post("/jobs", json={**body, "seeds": list(range(1_000))})
     assert again.status_code == 429, again.text
     assert "per client" in again.json()["detail"] and int(again.headers["Retry-After"]) >= 1
     server.client.delete(f"/jobs/{first.json()['id']}")

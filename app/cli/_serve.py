@@ -61,6 +61,7 @@ async def _run(app, api: socket.socket, host: str, ui: socket.socket, generated:
 
     import uvicorn
 
+    from app.server.header_deadline import HeaderDeadline
     from app.studio import launch
 
     api_port, ui_port = api.getsockname()[1], ui.getsockname()[1]
@@ -71,7 +72,8 @@ async def _run(app, api: socket.socket, host: str, ui: socket.socket, generated:
     try:
         if studio.port != ui_port:
             raise InputError(f"studio port {ui_port} on {host} became busy")
-        config = uvicorn.Config(app, log_level="warning", timeout_graceful_shutdown=1)
+        config = uvicorn.Config(app, log_level="warning", timeout_graceful_shutdown=1,
+                                http=HeaderDeadline)
         server = uvicorn.Server(config)
         serving = asyncio.create_task(server.serve(sockets=[api]))
         while not server.started and not serving.done():
