@@ -15,9 +15,10 @@ import numpy as np
 
 from planner._jit import float64, typeof
 from planner._world import RADIUS, World, build_world, pose_clearance
+from planner.obstacles import follow_waypoints
 from planner.scenario import Box, Circle, Scenario, ScenarioError
 
-__all__ = ["Problem", "check_room", "compile_problem", "follow_waypoints", "resolve_track"]
+__all__ = ["Problem", "check_room", "compile_problem", "resolve_track"]
 
 
 @dataclass(frozen=True)
@@ -94,17 +95,6 @@ def resolve_track(scenario: Scenario, load_track=None):
     if scenario.track.width_m is not None:
         track = track.with_width(scenario.track.width_m)
     return track
-
-
-def follow_waypoints(track, follow, step_s: float = 0.05) -> np.ndarray:
-    """A track-following motion as dense timed offsets from its position at t = 0."""
-    prof = track.sample(spacing=0.02)
-    times = np.arange(0.0, follow.horizon_s + step_s, step_s)
-    s = follow.start_s + follow.speed * times
-    s = np.mod(s, prof.s[-1]) if track.closed else np.clip(s, 0.0, prof.s[-1])
-    x = np.interp(s, prof.s, prof.x)
-    y = np.interp(s, prof.s, prof.y)
-    return np.column_stack([times, x - x[0], y - y[0]])
 
 
 def compile_problem(scenario: Scenario, load_track=None) -> Problem:

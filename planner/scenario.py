@@ -16,6 +16,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, ValidationError, model_validator
 
+from planner.obstacles import box_corners
 from planner.validation import StrictModel, Text, describe, location, suggest
 
 __all__ = [
@@ -230,10 +231,7 @@ class Box(StrictModel):
     motion: Motion | None = None
 
     def corners(self) -> list[Point]:
-        c, s = math.cos(math.radians(self.angle_deg)), math.sin(math.radians(self.angle_deg))
-        hx, hy = self.size[0] / 2, self.size[1] / 2
-        return [(self.center[0] + c * u - s * v, self.center[1] + s * u + c * v)
-                for u, v in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))]
+        return box_corners(self.center, self.size, self.angle_deg)
 
 
 Obstacle = Annotated[Circle | Polygon | Box, Field(discriminator="type")]

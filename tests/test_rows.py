@@ -12,7 +12,8 @@ from hypothesis import strategies as st
 
 import planner
 from planner._rows import chord_sag, polyline, polyline_clearance
-from planner.problem import follow_waypoints, resolve_track
+from planner.obstacles import follow_waypoints
+from planner.problem import resolve_track
 from planner.scenario import ScenarioError
 
 BUNDLED = [p.stem for p in sorted(planner.bundled_scenario_path("slalom").parent.glob("*.json"))]

@@ -15,7 +15,8 @@ import re
 import numpy as np
 
 from app.studio._gizmo import gizmo
-from app.studio._scene import DRAFT_RGB, Z, ground_point, obstacle_shape, polyline_segments
+from app.studio._scene import DRAFT_RGB, Z, ground_point, polyline_segments
+from planner.obstacles import outline
 
 __all__ = ["Editor", "moved_obstacle", "nearest_s", "parse_waypoints"]
 
@@ -40,7 +41,7 @@ class Editor:
         self._gizmos = []
         parsed, visible = self.stage.parsed, self._gizmos_visible
         for i, ob in enumerate(parsed.obstacles):
-            pose, _ = obstacle_shape(ob)
+            pose, _ = outline(ob)
             self._gizmos.append(gizmo(
                 self.scene, f"/edit/o{i}", pose,
                 lambda x, y, yaw, i=i: self.stage.preview_obstacle(i, x, y, yaw),
@@ -204,7 +205,7 @@ def moved_obstacle(ob: dict, parsed, x: float, y: float, yaw: float, track) -> d
     starts from the centreline point nearest its new place."""
     out = dict(ob)
     if ob["type"] == "polygon":
-        _, local = obstacle_shape(parsed)
+        _, local = outline(parsed)
         c, si = math.cos(yaw), math.sin(yaw)
         out["points"] = [_round(p) for p in local @ np.array([[c, si], [-si, c]]) + [x, y]]
     else:

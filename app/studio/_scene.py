@@ -12,13 +12,13 @@ import numpy as np
 import shapely
 
 import planner
-from planner.problem import follow_waypoints
+from planner.obstacles import motion_table, outline, table_offsets
 
 __all__ = ["CURVATURE_RGB", "CUSP_UNDER_RGB", "DRAFT_RGB", "GOAL_RGB", "MOVER_RGB", "OBSTACLE_RGB",
            "REVERSE_RGB", "START_RGB", "Z", "add_grid", "arc_length", "car_outline", "curvature_colors",
            "cusp_rows", "draw_car", "draw_obstacles", "draw_poses", "draw_track", "fit_camera",
-           "ground_point", "marker_size", "metres_per_px", "motion_table", "move_obstacles", "obstacle_rings",
-           "obstacle_shape", "offset_at", "path_layers", "polyline_segments", "reversing",
+           "ground_point", "marker_size", "metres_per_px", "move_obstacles", "obstacle_rings",
+           "path_layers", "polyline_segments", "reversing",
            "wxyz_yaw", "yaw_wxyz"]
 
 # Obstacles above the tree: edges pass where a moving obstacle is at other times.
@@ -151,51 +151,16 @@ def wxyz_yaw(wxyz) -> float:
     return 2.0 * math.atan2(z, w)
 
 
-def obstacle_shape(ob) -> tuple[tuple[float, float, float], np.ndarray]:
-    """An obstacle as a pose (x, y, yaw) and its outline in its own frame: dragging moves and
-    turns the pose, animation offsets it, and the outline is triangulated once."""
-    if ob.type == "circle":
-        a = np.linspace(0, 2 * math.pi, 48, endpoint=False)
-        return (*ob.center, 0.0), ob.radius * np.column_stack([np.cos(a), np.sin(a)])
-    if ob.type == "box":
-        hx, hy = ob.size[0] / 2, ob.size[1] / 2
-        return ((*ob.center, math.radians(ob.angle_deg)),
-                np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]]))
-    pts = np.array(ob.points, dtype=float)
-    c = np.asarray(shapely.Polygon(pts).centroid.coords[0])
-    return (*c, 0.0), pts - c
-
-
 def obstacle_rings(scenario: planner.Scenario, t: float = 0.0, track=None) -> list[np.ndarray]:
     """Each obstacle's outline in world coordinates at time t (``track``: for obstacles that
     follow it)."""
     out = []
     for ob in scenario.obstacles:
-        (x, y, yaw), local = obstacle_shape(ob)
+        (x, y, yaw), local = outline(ob)
         c, s = math.cos(yaw), math.sin(yaw)
         out.append(local @ np.array([[c, s], [-s, c]]) + [x, y]
-                   + offset_at(motion_table(ob.motion, track), t))
+                   + table_offsets(motion_table(ob.motion, track), t)[0])
     return out
-
-
-def motion_table(motion, track) -> np.ndarray | None:
-    """A motion as rows (t, dx, dy) whose linear interpolation (clamped) is the obstacle's
-    offset at time t, as the planner reads it; None for a static obstacle."""
-    if motion is None:
-        return None
-    if motion.velocity is not None:
-        horizon = 1e4
-        return np.array([[0.0, 0.0, 0.0], [horizon, *(np.array(motion.velocity) * horizon)]])
-    if motion.waypoints is not None:
-        return np.array(motion.waypoints, dtype=float)
-    return follow_waypoints(track, motion.follow_track)
-
-
-def offset_at(table: np.ndarray | None, t: float) -> np.ndarray:
-    if table is None:
-        return np.zeros(2)
-    return np.array([np.interp(t, table[:, 0], table[:, 1]),
-                     np.interp(t, table[:, 0], table[:, 2])])
 
 
 def draw_obstacles(scene, scenario: planner.Scenario, track, root: str = "") -> list[tuple]:
@@ -204,7 +169,7 @@ def draw_obstacles(scene, scenario: planner.Scenario, track, root: str = "") -> 
     `move_obstacles`."""
     out = []
     for i, ob in enumerate(scenario.obstacles):
-        pose, local = obstacle_shape(ob)
+        pose, local = outline(ob)
         frame = scene.add_frame(f"{root}/obstacles/o{i}", show_axes=False, position=(*pose[:2], 0.0),
                                 wxyz=yaw_wxyz(pose[2]))
         moves = ob.motion is not None
@@ -218,7 +183,7 @@ def move_obstacles(drawn: list[tuple], t: float) -> None:
     """Put each moving obstacle where it is at scene time t (a position update, no mesh)."""
     for frame, pose, table in drawn:
         if table is not None:
-            frame.position = (*(np.array(pose[:2]) + offset_at(table, t)), 0.0)
+            frame.position = (*(np.array(pose[:2]) + table_offsets(table, t)[0]), 0.0)
 
 
 def car_outline(length: float, width: float) -> np.ndarray:

@@ -14,8 +14,10 @@ does never shows in another. Each part owns its state and is its only writer:
 
 The session wires the controls to them and does what spans parts: a new track or scenario
 resets the rest. UI callbacks only change state and restart workers; the ticker thread pushes
-the workers' progress to the browser at ~25 Hz, holding the lock, as does every callback that
-replaces what the ticker draws.
+the workers' progress to the browser at ~25 Hz, holding the lock, as does every callback while
+it replaces what the ticker draws: directly (`_locked`), or through `apply_scenario` and
+`set_track`, which compile outside the lock and take it to swap the drawing (a gizmo's drag
+goes that way, so its own ``on_update`` needs no lock).
 """
 
 from __future__ import annotations

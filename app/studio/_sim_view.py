@@ -35,10 +35,10 @@ from app.studio._scene import (
     _fill,
     draw_car,
     marker_size,
-    obstacle_shape,
     polyline_segments,
     yaw_wxyz,
 )
+from planner.obstacles import outline
 from planner.sim import SimSettings
 from planner.sim.control import CONTROLLERS
 from planner.sim.predict import Lanes, believed_offsets
@@ -281,15 +281,15 @@ class SimView:
         for i, ob in enumerate(scn.obstacles):
             if self._movers[i] < 0 or known[self._movers[i]]:
                 continue
-            (x, y, yaw), local = obstacle_shape(ob)  # offsets move the declared pose
+            (x, y, yaw), local = outline(ob)  # offsets move the declared pose
             self._centres[i] = np.array([x, y])
             self._handles[f"ghost{i}"] = scene.add_frame(
                 f"/sim/ghost{i}", show_axes=False, position=(x, y, 0.0), wxyz=yaw_wxyz(yaw))
             _fill(scene, f"/sim/ghost{i}/shape", [local], GHOST_Z, GHOST_RGB,
                   opacity=0.35)
-            outline = shapely.Polygon(local)
+            shape = shapely.Polygon(local)
             for k, (tau, alpha) in enumerate(zip(LOOK_AHEAD_S, GROWN_OPACITY)):
-                grown = outline.buffer(float(self._uncertainty.growth(tau)), quad_segs=8)
+                grown = shape.buffer(float(self._uncertainty.growth(tau)), quad_segs=8)
                 self._handles[f"grown{i}_{k}"] = scene.add_frame(
                     f"/sim/grown{i}_{k}", show_axes=False, position=(x, y, 0.0),
                     wxyz=yaw_wxyz(yaw))

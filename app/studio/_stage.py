@@ -20,9 +20,9 @@ from app.studio._scene import (
     fit_camera,
     marker_size,
     move_obstacles,
-    offset_at,
     yaw_wxyz,
 )
+from planner.obstacles import table_offsets
 
 __all__ = ["Stage"]
 
@@ -65,7 +65,7 @@ class Stage:
         """Obstacle i drawn at pose (x, y, yaw), plus its motion's offset at the scene time,
         while a gizmo drags it."""
         frame, _, table = self._drawn[i]
-        dx, dy = offset_at(table, self.clock.t)
+        dx, dy = table_offsets(table, self.clock.t)[0]
         _move_frame(frame, x + dx, y + dy, yaw)
 
     def preview_pose(self, key: str, x: float, y: float, yaw: float) -> None:

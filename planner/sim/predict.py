@@ -32,8 +32,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from planner._world import VELOCITY, VMAX_OBS, WAYPOINTS, World
+from planner.obstacles import reference_points
 from planner.problem import resolve_track
-from planner.sim.sensing import Sensing, motion_anchors
+from planner.sim.sensing import Sensing
 
 __all__ = ["HORIZON_S", "Lanes", "Uncertainty", "believed_offsets", "predicted_world"]
 
@@ -90,7 +91,7 @@ class Lanes:
         prof = track.sample(spacing=LANE_SPACING)
         return cls(prof.s, np.column_stack([prof.x, prof.y]),
                    np.column_stack([-np.sin(prof.heading), np.cos(prof.heading)]),
-                   track.closed, motion_anchors(scenario))
+                   track.closed, reference_points(scenario.obstacles))
 
     def advance(self, offsets: np.ndarray, velocities: np.ndarray, lag: np.ndarray) -> np.ndarray:
         """(len(lag), n, 2): the offsets of movers sensed at ``offsets`` with ``velocities``,

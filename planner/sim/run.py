@@ -217,6 +217,10 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     uncertainty = s.uncertainty(scenario)
     lanes = Lanes.of(scenario, load_track)
     goal = problem.goal_region()
+    fsm = Behaviour(behaviour, problem.world, limits.wheelbase, dt) if behaviour else None
+    # FollowTrack caps its own speed; timing optimal drives as fast as the car may.
+    cruise = vehicle.speed if fsm is None and s.timing == "constant" else limits.max_speed
+
     def new_replanner() -> Replanner:
         # No polishing: a cycle's budget is a few milliseconds, and the next cycle replans.
         return Replanner(problem, PlanOptions(seed=s.seed, polish=False, timing=s.timing,
@@ -226,9 +230,6 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                          iterations=s.iterations if fixed is not None else None,
                          margin=s.margin, uncertainty=uncertainty, lanes=lanes)
 
-    fsm = Behaviour(behaviour, problem.world, limits.wheelbase, dt) if behaviour else None
-    # FollowTrack caps its own speed; timing optimal drives as fast as the car may.
-    cruise = vehicle.speed if fsm is None and s.timing == "constant" else limits.max_speed
     replanner = new_replanner()
     gains = Tracking()
     # Heading noise as if θ came from two position fixes a wheelbase apart.

@@ -11,8 +11,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from planner._world import VELOCITY, World
+from planner.obstacles import table_offsets
 
-__all__ = ["Sensing", "known_motions", "motion_anchors", "mover_index", "sense", "true_offsets"]
+__all__ = ["Sensing", "known_motions", "mover_index", "sense", "true_offsets"]
 
 
 def mover_index(scenario) -> np.ndarray:
@@ -30,14 +31,6 @@ def known_motions(scenario) -> np.ndarray:
                     dtype=bool)
 
 
-def motion_anchors(scenario) -> np.ndarray:
-    """(n_motions, 2), world order: the point of each mover that its offset moves from (a
-    circle's or box's centre, a polygon's mean vertex)."""
-    return np.array([np.mean(ob.points, axis=0) if ob.type == "polygon"
-                     else ob.center for ob in scenario.obstacles if ob.motion is not None],
-                    dtype=float).reshape(-1, 2)
-
-
 def true_offsets(world: World, movers: np.ndarray, times) -> np.ndarray:
     """(len(times), n_obstacles, 2): every obstacle's true offset at each time (0 when static).
 
@@ -51,9 +44,8 @@ def true_offsets(world: World, movers: np.ndarray, times) -> np.ndarray:
         if world.m_kind[m] == VELOCITY:
             out[:, i] = times[:, None] * world.m_vel[m]
         else:
-            wp = world.m_wp[world.m_wp_start[m]:world.m_wp_start[m + 1]]
-            out[:, i, 0] = np.interp(times, wp[:, 0], wp[:, 1])
-            out[:, i, 1] = np.interp(times, wp[:, 0], wp[:, 2])
+            out[:, i] = table_offsets(world.m_wp[world.m_wp_start[m]:world.m_wp_start[m + 1]],
+                                      times)
     return out
 
 
