@@ -318,3 +318,33 @@ def test_blocked_lane_ends_in_an_emergency_stop_not_a_collision(tmp_path):
     assert not s["reached_goal"] and s["emergency_stops"] >= 1
     assert s["collisions"] == 0 and _independent_collisions(scn, run.log) == 0
     assert abs(run.log[-1, 4]) < 1e-9 and run.log[-1, 1] < 8.3  # at rest, before the box
+
+
+def test_a_new_plan_keeps_the_stretch_the_steering_cannot_change():
+    """Each replacement keeps the trajectory ahead of the car for as far as it drives while its
+    steering swings from lock to lock (2·δmax/δ̇: 0.29 s at 26° and 180°/s). A plan that bent
+    right in front of the car would ask the steering for what it cannot do: on a tightest
+    S-bend the car drifted 12 cm wide into `gate`'s wall."""
+    scn = planner.load_scenario("crowd_square")
+    seen, guards = [], set()
+
+    def observe(f):
+        guards.add(f.guard)
+        if f.reference is not None and (not seen or f.reference is not seen[-1][1]):
+            # Only plans on the plan: an evasion drops it, and the car plans afresh.
+            seen.append((f.pose, f.reference, f.v if guards == {"follow"} else 0.0))
+            guards.clear()
+
+    simulate(scn, SimSettings(rate=30.0, fixed_latency_ms=20.0, duration=10.0, seed=0),
+             observer=observe)
+    swing = 2.0 * scn.vehicle.max_steer_deg / scn.vehicle.max_steer_rate_deg_s
+    checked = 0
+    for (_, old, _), (pose, new, v) in zip(seen, seen[1:]):
+        if v < 0.5:  # standing, or the guard has the car off the plan (it plans afresh)
+            continue
+        i, _ = Reference(old.rows).project(*pose[:2])
+        ahead = old.rows[(old.s >= old.s[i]) & (old.s <= old.s[i] + 0.9 * v * swing), :2]
+        gaps = np.linalg.norm(ahead[:, None] - new.rows[None, :, :2], axis=2).min(axis=1)
+        assert gaps.max() < 1e-9, (pose, v, gaps.max())
+        checked += 1
+    assert checked >= 20

@@ -67,10 +67,15 @@ class Reference:
 
 @dataclass(frozen=True)
 class Tracking:
-    """Controller gains. Look-ahead of pure pursuit: max(lookahead_min, lookahead_gain·|v|)."""
+    """Controller gains. Look-ahead of pure pursuit: max(lookahead_min, lookahead_gain·|v|).
+
+    Pure pursuit cuts a bend's change of curvature Δκ by about look-ahead²·Δκ / 8; a plan's
+    tightest S-bend (Δκ = 2/ρ, 2.2 /m for the model car) is cut by 9 cm at 0.6 m, more than
+    the simulator's planning margin (5 cm; the guard trusts tracking to half of it), and by
+    3 cm at 0.35 m (0.35 s at 1 m/s)."""
 
     lookahead_min: float = 0.35
-    lookahead_gain: float = 0.6
+    lookahead_gain: float = 0.35
     stanley_k: float = 1.5
     stanley_soft: float = 0.2
     pd_p: float = 2.0

@@ -93,8 +93,12 @@ class Replanner:
         """Plan from the state the car will be in ``lead_s`` seconds after t."""
         started = time.perf_counter()
         self.count += 1
-        a = self.problem.scenario.vehicle.max_accel
-        commit = max(v, 0.0) * lead_s + 0.5 * a * lead_s ** 2 if v > 1e-9 else 0.0
+        vehicle = self.problem.scenario.vehicle
+        a = vehicle.max_accel
+        # Committed too: what the car drives while its steering swings from lock to lock. A
+        # plan that bent nearer would ask the steering for what it cannot do (a drift wide).
+        swing = 2.0 * vehicle.max_steer_deg / vehicle.max_steer_rate_deg_s
+        commit = max(v, 0.0) * (lead_s + swing) + 0.5 * a * lead_s ** 2 if v > 1e-9 else 0.0
         root, anchor, skip, s_c = self._commit_point(pose, s_now, commit)
         believed = predicted_world(self.problem.world, sensing, t + lead_s, self.uncertainty,
                                    self.known, self.lanes)
