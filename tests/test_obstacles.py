@@ -11,8 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import planner
-from planner.obstacles import (box_corners, motion_table, outline, reference_points,
-                               table_offsets)
+from planner.obstacles import box_corners, motion_table, outline, reference_points, table_offsets
 from planner.problem import resolve_track
 from planner.scenario import parse_scenario
 from planner.sim.sensing import mover_index, true_offsets

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import json
 import math
 import subprocess
@@ -339,7 +340,7 @@ def test_a_new_plan_keeps_the_stretch_the_steering_cannot_change():
              observer=observe)
     swing = 2.0 * scn.vehicle.max_steer_deg / scn.vehicle.max_steer_rate_deg_s
     checked = 0
-    for (_, old, _), (pose, new, v) in zip(seen, seen[1:]):
+    for (_, old, _), (pose, new, v) in itertools.pairwise(seen):
         if v < 0.5:  # standing, or the guard has the car off the plan (it plans afresh)
             continue
         i, _ = Reference(old.rows).project(*pose[:2])
