@@ -108,10 +108,10 @@ class Lanes:
         s = s0 + along * np.asarray(lag, dtype=float)[:, None]
         length = self.s[-1]
         s = np.mod(s, length) if self.closed else np.clip(s, 0.0, length)
-        at = self._point(s0[None], 0.0)[0]
-        beside = np.einsum("mj,mj->m", p - at, self._normal(s0[None])[0])
-        moved = self._point(s, beside)
-        return moved + (p - self._point(s0[None], beside)[0]) - self.anchors
+        at, normal = self._point(s0, 0.0), self._normal(s0)
+        beside = np.einsum("mj,mj->m", p - at, normal)
+        off_lane = p - at - beside[:, None] * normal  # the sampling's along-lane slack, ~mm
+        return self._point(s, beside) + off_lane - self.anchors
 
     def _normal(self, s: np.ndarray) -> np.ndarray:
         n = np.stack([np.interp(s, self.s, self.normal[:, k]) for k in (0, 1)], axis=-1)

@@ -71,8 +71,8 @@ class SimSettings:
         pick = {name: value for name, value in (
             ("accel", self.predict_accel), ("speed_error", self.predict_speed_error),
             ("horizon", self.predict_horizon)) if value is not None}
-        given = {k: v for k, v in (p.model_dump(exclude={"along_track"}) if p is not None else {}).items()
-                 if v is not None}
+        dumped = p.model_dump(exclude={"along_track"}) if p is not None else {}
+        given = {k: v for k, v in dumped.items() if v is not None}
         return Uncertainty(**{**given, **pick})
 
     def __post_init__(self) -> None:
