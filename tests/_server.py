@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import re
 import signal
+import socket
 import subprocess
 import threading
 import time
@@ -14,6 +15,13 @@ from pathlib import Path
 import httpx
 
 START_TIMEOUT_S = 60  # cold worker start on a loaded 2-core runner; normally ~2 s
+
+
+def free_port() -> int:
+    """A port nothing listens on now (the OS's pick)."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
 
 
 class Server:

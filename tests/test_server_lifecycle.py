@@ -14,16 +14,10 @@ from pathlib import Path
 
 import httpx
 import pytest
-from _server import Server
+from _server import Server, free_port
 from conftest import scenario_dict
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def test_data_survive_a_restart_and_an_interrupted_job_is_marked(tmp_path):

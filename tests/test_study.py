@@ -4,15 +4,20 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import re
+import secrets
 import signal
+import socket
 import sqlite3
 import subprocess
 import sys
 import time
+from contextlib import contextmanager
 
 import numpy as np
 import pytest
+from _server import free_port
 
 STUDY = """\
 name: small
@@ -294,6 +299,57 @@ def test_ray_stores_the_same_rows_as_the_local_pool_and_leaves_no_process(study_
     assert rows(ray) == rows(local) and len(rows(ray)) == 4
     left = subprocess.run(["pgrep", "-f", "raylet|gcs_server"], capture_output=True, text=True)
     assert left.stdout.strip() == "", "Ray processes outlived the command"
+
+
+@contextmanager
+def ray_head(env: dict):
+    """A Ray cluster of our own (`ray start --head`, with token authentication, as Ray 2.59+
+    starts one by default) on a free port; stopped, all its processes, on leaving."""
+    port = free_port()
+    head = subprocess.Popen(["ray", "start", "--head", f"--port={port}", "--num-cpus=2",
+                             "--include-dashboard=false", "--block"], env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60
+        while True:
+            try:
+                socket.create_connection(("127.0.0.1", port), timeout=1).close()
+                break
+            except OSError:
+                assert head.poll() is None and time.monotonic() < deadline, "no Ray head"
+                time.sleep(0.2)
+        yield f"127.0.0.1:{port}"
+    finally:
+        head.terminate()  # --block: ray start stops the cluster's processes as it ends
+        head.wait(timeout=60)
+
+
+def test_a_ray_cluster_at_ray_address_stores_the_local_pools_rows(study_file, tmp_path):
+    """A study on a cluster reached through RAY_ADDRESS (token authentication) stores the
+    local pool's rows; with that head running and no RAY_ADDRESS, --backend ray starts a Ray of
+    its own; a wrong address fails in one line and leaves no results file."""
+    pytest.importorskip("ray")
+    study_file.write_text(STUDY.replace(", ./my/slalom.json", "").replace("seeds: 2", "seeds: 1"))
+    outs = {name: tmp_path / name for name in ("local", "cluster", "own", "wrong")}
+    assert trackstar("study", str(study_file), "--out", str(outs["local"])).returncode == 0
+    env = {k: v for k, v in os.environ.items() if not k.startswith("RAY_")}
+    env |= {"RAY_AUTH_MODE": "token", "RAY_AUTH_TOKEN": secrets.token_hex(16)}
+
+    def study(out, **more):
+        return subprocess.run(["trackstar", "study", str(study_file), "--out", str(out),
+                               "--backend", "ray", "--workers", "2"], check=False,
+                              capture_output=True, text=True, env=env | more, timeout=120)
+
+    with ray_head(env) as address:
+        cluster = study(outs["cluster"], RAY_ADDRESS=address)
+        own = study(outs["own"])
+    wrong = study(outs["wrong"], RAY_ADDRESS=f"127.0.0.1:{free_port()}")
+    assert cluster.returncode == 0, cluster.stderr
+    assert own.returncode == 0, own.stderr
+    assert rows(outs["cluster"]) == rows(outs["own"]) == rows(outs["local"])
+    assert wrong.returncode == 2 and len(wrong.stderr.strip().splitlines()) == 1
+    assert "RAY_ADDRESS=127.0.0.1:" in wrong.stderr and "Connection refused" in wrong.stderr
+    assert not (outs["wrong"] / "results.sqlite").exists()
 
 
 def test_without_ray_the_ray_backend_says_how_to_install_it(study_file, tmp_path):

@@ -8,7 +8,13 @@ The pool's modules load with a pool: every command line names the backends.
 
 from __future__ import annotations
 
+import logging
 import os
+import socket
+import tempfile
+import threading
+import time
+from contextlib import contextmanager
 
 __all__ = ["BACKENDS", "LocalBackend", "RayBackend", "open_backend"]
 
@@ -44,8 +50,9 @@ class LocalBackend:
 
 
 class RayBackend:
-    """The Ray cluster at ``RAY_ADDRESS``, else a local Ray of ``workers`` CPUs; shut down on
-    close (also after Ctrl-C), so no Ray process outlives the command."""
+    """Ray tasks: on the cluster at ``RAY_ADDRESS`` when it is set, else on a Ray of this
+    command's own sized by ``workers`` (never on a head that happens to run on this machine).
+    Shut down on close (also after Ctrl-C), so no Ray process of ours outlives the command."""
 
     @staticmethod
     def check() -> None:
@@ -59,9 +66,12 @@ class RayBackend:
         import ray
 
         self._ray = ray
-        address = os.environ.get("RAY_ADDRESS")
-        ray.init(address=address or None, num_cpus=None if address else workers,
-                 include_dashboard=False, log_to_driver=False, configure_logging=False)
+        address = os.environ.get("RAY_ADDRESS", "").strip()
+        options = {"include_dashboard": False, "log_to_driver": False, "configure_logging": False}
+        if address:
+            _connect(ray, address, options)
+        else:
+            ray.init(address="local", num_cpus=workers, **options)
         self.workers = int(ray.cluster_resources().get("CPU", workers))
         self._remote: dict = {}
 
@@ -77,6 +87,72 @@ class RayBackend:
 
     def close(self) -> None:
         self._ray.shutdown()
+
+
+CONNECT_TIMEOUT_S = 25.0  # Ray itself retries a head that does not answer for ever
+RAY_PORT = 6379  # `ray start --head`'s default
+_AUTH_HINT = ("; `ray start` of Ray 2.59 and later wants token authentication: set "
+              "RAY_AUTH_MODE=token here and the cluster's token (docs/studies.md)")
+
+
+def _connect(ray, address: str, options: dict) -> None:
+    """`ray.init` on ``address`` within CONNECT_TIMEOUT_S, else ValueError in one line naming
+    the address. Ray's own complaints, printed while it retries, go to the error's hint."""
+    deadline = time.monotonic() + CONNECT_TIMEOUT_S
+    where = f"the Ray cluster at RAY_ADDRESS={address}"
+    if address != "auto":
+        try:
+            socket.create_connection(_host_port(address), timeout=CONNECT_TIMEOUT_S).close()
+        except OSError as exc:
+            raise ValueError(f"cannot reach {where}: {exc.strerror or exc} (is `ray start "
+                             f"--head` running there, and is the port open?)") from None
+    failed: list[Exception] = []
+
+    def init() -> None:
+        try:
+            ray.init(address=address, **options)
+        except Exception as exc:  # noqa: BLE001 - Ray raises several kinds; each ends here
+            failed.append(exc)
+
+    with _stderr_captured() as said:
+        thread = threading.Thread(target=init, name="ray-connect", daemon=True)
+        thread.start()
+        thread.join(max(deadline - time.monotonic(), 0.0))
+        complaints = said() + "".join(map(str, failed))
+    hint = _AUTH_HINT if "auth" in complaints.lower() else ""
+    if thread.is_alive():
+        raise ValueError(f"no answer from {where} within {CONNECT_TIMEOUT_S:.0f} s{hint}")
+    if failed:
+        first = str(failed[0]).strip().splitlines()[0] if str(failed[0]).strip() else ""
+        raise ValueError(f"cannot connect to {where}: {first or type(failed[0]).__name__}"
+                         f"{hint}")
+
+
+def _host_port(address: str) -> tuple[str, int]:
+    """``host:port`` (or ``ray://host:port``, ``[::1]:port``; the port defaults to Ray's)."""
+    rest = address.removeprefix("ray://").rstrip("/")
+    host, sep, port = rest.rpartition(":")
+    if not sep or "]" in port:
+        host, port = rest, str(RAY_PORT)
+    if not port.isdigit():
+        raise ValueError(f"RAY_ADDRESS={address} is not HOST:PORT (for example "
+                         f"head.example.edu:{RAY_PORT})")
+    return host.strip("[]"), int(port)
+
+
+@contextmanager
+def _stderr_captured():
+    """Send this process's stderr (file descriptor 2, where Ray's C++ core logs) to a file
+    meanwhile; yields a function that reads what was written."""
+    logging.getLogger("ray").setLevel(logging.ERROR)
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield lambda: (sink.seek(0), sink.read().decode(errors="replace"))[1]
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
 
 
 BACKENDS = {"local": LocalBackend, "ray": RayBackend}

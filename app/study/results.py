@@ -126,6 +126,13 @@ class Results:
     def close(self) -> None:
         self._db.close()
 
+    def discard(self) -> None:
+        """Close and delete the file (with its WAL files): for a study that stored nothing
+        because it could not start, so that no empty results file is left behind."""
+        self.close()
+        for suffix in ("", "-wal", "-shm"):
+            self.path.with_name(self.path.name + suffix).unlink(missing_ok=True)
+
 
 def _migrate(db: sqlite3.Connection) -> None:
     """Bring a results file of an older schema up to date (columns added, none removed)."""
