@@ -123,9 +123,9 @@ def _connect(ray, address: str, options: dict) -> None:
     if thread.is_alive():
         raise ValueError(f"no answer from {where} within {CONNECT_TIMEOUT_S:.0f} s{hint}")
     if failed:
-        first = str(failed[0]).strip().splitlines()[0] if str(failed[0]).strip() else ""
-        raise ValueError(f"cannot connect to {where}: {first or type(failed[0]).__name__}"
-                         f"{hint}")
+        said_ray = str(failed[0]).strip()
+        first = said_ray.splitlines()[0] if said_ray else type(failed[0]).__name__
+        raise ValueError(f"cannot connect to {where}: {first}{hint}")
 
 
 def _host_port(address: str) -> tuple[str, int]:
@@ -142,17 +142,24 @@ def _host_port(address: str) -> tuple[str, int]:
 
 @contextmanager
 def _stderr_captured():
-    """Send this process's stderr (file descriptor 2, where Ray's C++ core logs) to a file
-    meanwhile; yields a function that reads what was written."""
-    logging.getLogger("ray").setLevel(logging.ERROR)
-    saved = os.dup(2)
+    """Send this process's stderr (file descriptor 2, where Ray's C++ core logs) and Ray's
+    Python warnings to a file meanwhile; yields a function that reads what was written."""
+    ray_log = logging.getLogger("ray")
+    level, saved = ray_log.level, os.dup(2)
+    ray_log.setLevel(logging.ERROR)
+
+    def said() -> str:
+        sink.seek(0)
+        return sink.read().decode(errors="replace")
+
     with tempfile.TemporaryFile() as sink:
         os.dup2(sink.fileno(), 2)
         try:
-            yield lambda: (sink.seek(0), sink.read().decode(errors="replace"))[1]
+            yield said
         finally:
             os.dup2(saved, 2)
             os.close(saved)
+            ray_log.setLevel(level)
 
 
 BACKENDS = {"local": LocalBackend, "ray": RayBackend}

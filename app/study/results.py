@@ -73,6 +73,7 @@ class Results:
     def __init__(self, directory: Path, study: str, kind: str, file_text: str) -> None:
         directory.mkdir(parents=True, exist_ok=True)
         self.path = directory / "results.sqlite"
+        self.created = not self.path.exists()  # by this study command
         self.study = study
         self.table, self.columns = TABLES[kind], COLUMNS[kind]
         self._key = KEY if kind == "plan" else SIM_KEY
@@ -127,10 +128,10 @@ class Results:
         self._db.close()
 
     def discard(self) -> None:
-        """Close and delete the file (with its WAL files): for a study that stored nothing
-        because it could not start, so that no empty results file is left behind."""
+        """Close, and delete the file (with its WAL files) if this command created it: for a
+        study that stored nothing because it could not start, so no empty file is left."""
         self.close()
-        for suffix in ("", "-wal", "-shm"):
+        for suffix in ("", "-wal", "-shm") if self.created else ():
             self.path.with_name(self.path.name + suffix).unlink(missing_ok=True)
 
 

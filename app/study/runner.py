@@ -102,7 +102,6 @@ def run_study(study: Study, out: Path, workers: int, backend: str = "local") -> 
     """Run what ``out`` does not hold yet on ``backend`` (`backends.BACKENDS`). Ctrl-C stops
     the workers and raises KeyboardInterrupt once every finished run is stored."""
     started = time.perf_counter()
-    fresh = not (out / "results.sqlite").exists()
     results = Results(out, study.name, study.kind, study.text)
     try:
         done = results.done()
@@ -115,8 +114,7 @@ def run_study(study: Study, out: Path, workers: int, backend: str = "local") -> 
             try:
                 runner = open_backend(backend, min(workers, len(todo)))
             except BaseException:
-                if fresh:
-                    results.discard()
+                results.discard()
                 raise
             try:
                 _run_on(runner, study, todo, results)
