@@ -219,6 +219,12 @@ def test_scene_renders_a_library_track_and_run_grows_the_tree(browser, ui_url):
     assert pin_pixels(compared) > 300, "the pinned path is not drawn under the new run"
     assert pink_pixels(compared) > 200, "the new run drew no path"
     assert page.locator(".u-legend", has_text="pin 1 κ").count() == 1
+    # The legend gives this run's numbers and its difference against the pin.
+    page.get_by_text(re.compile(r"this run: RRT\*, Reeds-Shepp, seed 0 — cost [\d.]+ m, \d+ "
+                                r"nodes")).wait_for()
+    page.get_by_text(re.compile(r"vs pin 1: cost [+−±][\d.]+ m \([+−±][\d.]+ %\), nodes "
+                                r"[+−±]\d+")).wait_for()
+    page.screenshot(path=str(ARTIFACTS / "15_compare_legend.png"), full_page=True)
     page.close()
 
 

@@ -499,7 +499,23 @@ def test_pinned_runs_keep_their_colours_and_the_comparison_has_a_row_and_curves_
         assert 0 < float(row["time_to_first_solution_s"]) and float(row["min_clearance_m"]) >= 0
         assert float(row["max_abs_curvature_per_m"]) <= 1 / problem.rho + 1e-6
         assert row["timing"] == "constant" and row["waited_s"] == ""
-    assert "<b>pin 1</b>: RRT, Dubins, seed 0 — cost" in pins.legend_html()
+    # Compare shows the difference: each row after the first against the first (pin 1).
+    assert [r["compared_with"] for r in rows] == ["", "pin 1", "pin 1"]
+    assert all(rows[0][f"{k}_diff{x}"] == "" for k in ("cost", "nodes", "time_to_first_solution")
+               for x in ("", "_pct"))
+    for row, run in zip(rows[1:], compared[1:]):
+        for key, stem in (("cost", "cost"), ("nodes", "nodes"),
+                          ("time_to_first_solution_s", "time_to_first_solution")):
+            a, b = float(row[key]), float(rows[0][key])
+            assert float(row[f"{stem}_diff"]) == pytest.approx(a - b, rel=1e-5, abs=1e-9)
+            assert float(row[f"{stem}_diff_pct"]) == pytest.approx(100 * (a - b) / b, rel=1e-4)
+    assert int(rows[0]["nodes"]) == rrt.metrics["nodes"] < int(rows[1]["nodes"])
+    legend = pins.legend_html((star,))
+    assert "<b>pin 1</b>: RRT, Dubins, seed 0 — cost" in legend
+    gain = 100 * (star.metrics["cost"] - rrt.metrics["cost"]) / rrt.metrics["cost"]
+    less = abs(star.metrics["cost"] - rrt.metrics["cost"])
+    assert gain < 0 and f"vs pin 1: cost −{less:.3g} m (−{abs(gain):.2g} %)" in legend
+    assert legend.count("vs pin 1:") == 2 and f"{star.metrics['nodes']} nodes" in legend
 
     charts = []
     gui = SimpleNamespace(add_uplot=lambda data, series, **k: charts.append(

@@ -35,9 +35,15 @@ CURRENT = "#{:02x}{:02x}{:02x}".format(*PATH_RGB)  # the current run: the best p
 # tree's blue and the warm colours of obstacles, movers, goal and rewire flashes.
 SPLIT_B = "#78c800"
 MAX_PINS = len(PALETTE)  # a pin beyond these replaces the oldest
-COLUMNS = ("run", "colour", "planner", "steering", "seed", "timing", "iterations", "cost",
-           "cost_unit", "length_m", "time_to_first_solution_s", "min_clearance_m",
+# What "Compare" measures each run against the first row by (the oldest pin; A without pins).
+DIFFS = (("cost", "cost", "cost"), ("nodes", "nodes", "nodes"),
+         ("first solution", "time_to_first_solution_s", "time_to_first_solution"))
+COLUMNS = ("run", "colour", "planner", "steering", "seed", "timing", "iterations", "nodes",
+           "cost", "cost_unit", "length_m", "time_to_first_solution_s", "min_clearance_m",
            "max_abs_curvature_per_m", "waited_s",
+           # the difference against the first row: this row's value minus its, and in %
+           "compared_with", *(f"{stem}_diff{suffix}" for _, _, stem in DIFFS
+                              for suffix in ("", "_pct")),
            # the car it planned for (pins stay across Vehicle edits, to compare cars)
            "wheelbase_m", "max_steer_deg", "turning_radius_m", "footprint", "disc_radius_m",
            "car_length_m", "car_width_m", "safety_margin_m")
@@ -83,11 +89,40 @@ class Run:
 
     @property
     def summary(self) -> str:
+        """Its result in words: cost, nodes, time to the first solution, iterations."""
         if self.cost is None:
             return "no path yet"
-        cost = (f"arrives after {self.cost:.3g} s (waits {self.metrics['waited_s']:.3g} s)"
+        m = self.metrics
+        cost = (f"arrives after {self.cost:.3g} s (waits {m['waited_s']:.3g} s)"
                 if self.optimal else f"cost {self.cost:.4g} m")
-        return f"{cost}, {self.metrics.get('iterations', 0)} iterations"
+        first = m.get("time_to_first_solution_s")
+        first = f", first solution {first:.3g} s" if first is not None else ""
+        return f"{cost}, {m.get('nodes', 0)} nodes{first}, {m.get('iterations', 0)} iterations"
+
+    def value(self, key: str) -> float | None:
+        """A compared value (a `DIFFS` key of `row`): the cost, nodes or time to the first
+        solution (None when the run has none, or has no path)."""
+        v = self.cost if key == "cost" else self.metrics.get(key)
+        return None if v is None or self.cost is None else float(v)
+
+    def diffs(self, base: Run) -> dict[str, tuple[float, float | None]]:
+        """Per compared value, (this run's minus ``base``'s, the same in % of ``base``'s; None
+        where that is 0); only values both runs have, and costs of one unit."""
+        out = {}
+        for word, key, _ in DIFFS:
+            a, b = self.value(key), base.value(key)
+            if a is None or b is None or (key == "cost" and self.optimal != base.optimal):
+                continue
+            out[word] = (a - b, 100.0 * (a - b) / b if b else None)
+        return out
+
+    def versus(self, base: Run) -> str:
+        """The differences against ``base`` in words: "vs pin 1: cost −0.26 m (−2.7 %), …"."""
+        units = {"cost": " s" if self.optimal else " m", "nodes": "", "first solution": " s"}
+        parts = [f"{word} {_signed(d, units[word], None if word == 'nodes' else 3)}"
+                 + (f" ({_signed(pct, ' %', 2)})" if pct is not None else "")
+                 for word, (d, pct) in self.diffs(base).items()]
+        return f"vs {base.name}: " + (", ".join(parts) if parts else "nothing to compare yet")
 
     def steering_deg(self) -> np.ndarray:
         return np.degrees(np.arctan(self.vehicle.wheelbase * self.path[:, 3]))
@@ -102,19 +137,33 @@ class Run:
             t, c = np.append(t, until), np.append(c, c[-1])
         return t, c
 
-    def row(self) -> dict:
-        """The run's line of the comparison CSV (see COLUMNS)."""
+    def row(self, base: Run | None = None) -> dict:
+        """The run's line of the comparison CSV (see COLUMNS), with its differences against
+        ``base``."""
         m, o, solved = self.metrics, self.options, len(self.path) > 1
+        diffs = self.diffs(base) if base is not None else {}
+        compared = {f"{stem}_diff{suffix}": diffs[word][k] if word in diffs else None
+                    for word, _, stem in DIFFS for k, suffix in enumerate(("", "_pct"))}
         return {
             "run": self.name, "colour": self.colour, "planner": o.planner,
             "steering": o.steering, "seed": o.seed, "timing": o.timing,
-            "iterations": m.get("iterations"), "cost": self.cost,
+            "iterations": m.get("iterations"), "nodes": m.get("nodes"), "cost": self.cost,
             "cost_unit": "s" if self.optimal else "m",
             "length_m": arc_length(self.path)[-1] if solved else None,
             "time_to_first_solution_s": m.get("time_to_first_solution_s"),
             "min_clearance_m": m.get("min_clearance_m"),
             "max_abs_curvature_per_m": np.abs(self.path[:, 3]).max() if solved else None,
-            "waited_s": m.get("waited_s"), **_car_cells(self.vehicle)}
+            "waited_s": m.get("waited_s"),
+            "compared_with": base.name if base is not None else None, **compared,
+            **_car_cells(self.vehicle)}
+
+
+def _signed(v: float, unit: str, digits: int | None = 3) -> str:
+    """A difference with its sign, a minus sign for less: "+58", "−0.26 m", "±0 %" (``digits``
+    None: a count)."""
+    text = f"{abs(v):.0f}" if digits is None else f"{abs(v):.{digits}g}"
+    sign = "±" if float(text) == 0 else "+" if v > 0 else "−"
+    return f"{sign}{text}{unit}"
 
 
 def settings_words(options: planner.PlanOptions) -> list[str]:
@@ -183,15 +232,20 @@ class Pins:
                                                  thickness=0.75 * px * scale,
                                                  thickness_units="screen")
 
-    def legend_html(self, current: tuple = ((CURRENT, "this run"),)) -> str:
-        """Each pin's colour, settings, result and car, then the current runs' colours and
-        names (``current``: (colour, name) pairs; A and B in the split)."""
-        rows = [f"{_swatch(r.colour)} <b>{r.name}</b>: {r.label} — {r.summary}<br>"
-                f"<span style='margin-left:2.2em;color:#777'>car: {html.escape(r.car)}</span>"
-                for r in self.runs]
-        return ("<div style='font-size:12px;line-height:1.6'>"
-                + "<br>".join([*rows, *(f"{_swatch(c)} {html.escape(name)}" for c, name in current)])
-                + "</div>")
+    def legend_html(self, current: tuple = ()) -> str:
+        """Each pin's colour, settings, result and car, then the current runs' (``current``:
+        `Run`s; A and B in the split) with their results; each after the first says how it
+        differs from the first (pin 1)."""
+        runs = [*self.runs, *current]
+        rows = []
+        for k, r in enumerate(runs):
+            notes = [f"car: {r.car}"] if k < len(self.runs) else []
+            notes += [r.versus(runs[0])] if k else []
+            rows.append(f"{_swatch(r.colour)} <b>{html.escape(r.name)}</b>: {r.label} — "
+                        f"{r.summary}" + "".join(
+                            f"<br><span style='margin-left:2.2em;color:#777'>"
+                            f"{html.escape(n)}</span>" for n in notes))
+        return "<div style='font-size:12px;line-height:1.6'>" + "<br>".join(rows) + "</div>"
 
 
 def _swatch(colour: str) -> str:
@@ -203,12 +257,13 @@ def hex_rgb(colour: str) -> tuple[int, int, int]:
 
 
 def comparison_csv(runs: list[Run]) -> str:
-    """One row per run (see COLUMNS); empty cells for what a run does not have."""
+    """One row per run (see COLUMNS), each after the first with its differences against the
+    first; empty cells for what a run does not have."""
     out = io.StringIO()
     writer = csv.DictWriter(out, COLUMNS, lineterminator="\n")
     writer.writeheader()
-    for run in runs:
-        writer.writerow({k: _cell(v) for k, v in run.row().items()})
+    for k, run in enumerate(runs):
+        writer.writerow({c: _cell(v) for c, v in run.row(runs[0] if k else None).items()})
     return out.getvalue()
 
 

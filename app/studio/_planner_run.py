@@ -347,11 +347,11 @@ class PlannerRun:
         self._profiles.set_pins(self.pins.runs)
 
     def _show_pins_legend(self) -> None:
-        """The pins' legend, ending with the current run's colour (A's and B's in the
-        split)."""
-        current = ((CURRENT, "this run"),) if not self.splitting else tuple(
-            (r.colour, f"{r.name}: {r.label}") for r in (self.current(), self.current_b()))
-        self.ui.pins_legend.content = self.pins.legend_html(current)
+        """The pins' legend, ending with the current run (A and B in the split) and how it
+        differs from the first pin; shown while there are pins."""
+        if self.pins.runs:
+            self.ui.pins_legend.content = self.pins.legend_html(
+                tuple(r for r in self._compared_now() if r is not None))
         self.ui.pins_legend.visible = bool(self.pins.runs)
 
     # -- the car -------------------------------------------------------------------------------
@@ -414,6 +414,7 @@ class PlannerRun:
         if versions != self._shown["metrics"]:
             self._shown["metrics"] = versions
             self.ui.metrics.content = _metrics_md(*metrics)
+            self._show_pins_legend()  # this run's numbers and difference
         if time.monotonic() - self._shown.get("plotted", 0.0) > PLOT_S:
             self._plot(lives)
         steps = tuple(live.step_version for live in lives)
