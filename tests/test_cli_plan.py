@@ -222,3 +222,43 @@ def test_an_animated_run_is_the_run_and_the_studio_gets_it_as_a_gif():
     gif = animation_gif(planner.compile_problem(slalom), options)
     with Image.open(io.BytesIO(gif)) as im:
         assert im.format == "GIF" and im.n_frames == FRAMES
+
+
+def test_the_studios_animation_is_the_run_on_screen():
+    """Timing optimal among movers (issue 33, item 4): the GIF plans with the studio's planner
+    (not the constant-speed one), to the iterations the screen shows, so its last tree frame
+    has the panel's nodes and cost; then the car drives the result while the mover moves."""
+    import io
+
+    from PIL import Image, ImageChops
+
+    from app.animate import DRIVE_FRAMES, FRAMES, FrameRecorder, animation_gif
+    from app.planning import advance_in_parts
+    from app.studio._worker import Lane
+
+    problem = planner.compile_problem(planner.load_scenario("crossing"))
+    options = planner.PlanOptions(iterations=2000, seed=1, timing="optimal")
+    lane = Lane(problem, options)  # the studio's run, stepped in its uneven batches
+    for batch in (1, 7, 50, 130, 62):
+        lane.advance(batch, stepping=False)
+    shown = lane.metrics()
+    recorder = FrameRecorder()
+    advance_in_parts(planner.planner_for(problem, options), None, lane.stepped, FRAMES, recorder)
+    last = recorder.frames[-1]
+    assert (last.iterations, last.tree.nodes, last.cost) == (
+        shown["iterations"], shown["nodes"], shown["cost"])
+    constant = FrameRecorder()  # what the download drew before: another run
+    at_constant_speed = options.model_copy(update={"timing": "constant"})
+    advance_in_parts(planner.planner_for(problem, at_constant_speed), None, lane.stepped, FRAMES,
+                     constant)
+    assert constant.frames[-1].tree.nodes != shown["nodes"]
+
+    gif = animation_gif(problem, options, lane.stepped)
+    with Image.open(io.BytesIO(gif)) as im:
+        assert im.n_frames == FRAMES + DRIVE_FRAMES
+        frames = []
+        for k in (FRAMES - 1, FRAMES + DRIVE_FRAMES // 2, FRAMES + DRIVE_FRAMES - 1):
+            im.seek(k)
+            frames.append(im.convert("RGB"))
+    for a, b in zip(frames, frames[1:]):  # the car and the disc move
+        assert ImageChops.difference(a, b).getbbox() is not None

@@ -493,6 +493,37 @@ def test_a_scenario_saved_to_the_server_loads_back_with_its_track(browser, urls,
     other.close()
 
 
+def test_the_animation_download_is_the_run_on_screen(browser, ui_url):
+    """Issue 33, item 4: `crossing` (a disc crosses), fastest arrival, paused part-way: the
+    GIF is that run — planned with the same timing to the iterations on screen — and ends
+    with the car driving its result while the disc moves."""
+    from PIL import Image
+
+    from app.animate import DRIVE_FRAMES, FRAMES
+
+    page = open_tab(browser, ui_url)
+    before = canvas_pixels(page)
+    show_folder(page, "Scenario", "Load from server")
+    set_text(page, "Name", "crossing")
+    click(page, "Load from server")
+    wait_until(page, lambda img: np.abs(img.astype(int) - before.astype(int)).mean() > 10)
+    page.get_by_label("Timing", exact=True).click(force=True)
+    page.get_by_role("option", name="fastest arrival (may wait)", exact=True).click(force=True)
+    page.locator("tr", has_text="rewires").wait_for(state="detached")  # the new run's metrics
+    click(page, "Run")
+    page.locator("tr", has_text="arrives after").wait_for(timeout=30000)
+    click(page, "Pause")
+    page.get_by_text(re.compile(r"Status: (paused|done)")).wait_for()
+    page.screenshot(path=str(ARTIFACTS / "16_animation_panel.png"))
+    with page.expect_download(timeout=60000) as dl:
+        click(page, "Download animation (GIF)")
+    with Image.open(dl.value.path()) as gif:
+        assert gif.n_frames == FRAMES + DRIVE_FRAMES  # the drive frames: a mover moves
+        gif.seek(gif.n_frames - 1)
+        gif.convert("RGB").save(ARTIFACTS / "16_animation_last_frame.png")
+    page.close()
+
+
 def frame(img: np.ndarray) -> tuple[float, ...]:
     """The track's drawn shape (width over height) and where the red box lies in it
     (fractions of the track's width and height)."""

@@ -34,7 +34,8 @@ def plan(
     animate: Annotated[Path | None, typer.Option(
         "--animate", show_default=False,
         help="Also write an animation of the run, for slides: the tree growing, its rewires "
-             "and the best path, 40 frames at 800x600 (.gif).")] = None,
+             "and the best path, 40 frames at 800x600 (.gif); where obstacles move, 24 more "
+             "drive the car along the result among them.")] = None,
 ) -> None:
     """Plan a path for the car from start to goal with RRT or RRT*."""
     import planner as core
@@ -51,7 +52,7 @@ def plan(
                           chunks=FRAMES if animate else 1)
         if animate is not None:
             write_animation(recorder.frames, recorder.problem,
-                            title(report.scenario, options), animate)
+                            title(report.scenario, options), animate, drive=recorder.drive())
         if raceline is not None and report.solved:
             from app.raceline import path_raceline, raceline_limits  # loads the tracks package
 

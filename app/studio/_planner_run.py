@@ -90,6 +90,14 @@ class PlannerRun:
         except ValidationError as exc:
             raise ValueError(describe(exc).replace("iterations:", "Budget:")) from None
 
+    def iterations_on_screen(self, options: planner.PlanOptions) -> int | None:
+        """The iterations the run on screen has done when it runs with ``options`` (the
+        panel's now; None otherwise): an export then draws that run to where it is."""
+        if self.worker is None:
+            return None
+        lane = self.worker.lanes[0]
+        return lane.stepped if lane.options == options and lane.stepped else None
+
     def _options_b(self, a: planner.PlanOptions, problem) -> planner.PlanOptions | None:
         """Run B's options in the split (A's, with B's planner, steering and seed); None
         outside it. A steering this robot cannot drive is refused: B then plans as A."""

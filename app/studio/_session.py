@@ -245,22 +245,26 @@ class Session:
 
     def _download_animation(self) -> None:
         """The current settings' run drawn as a GIF, rendered on a thread of its own (a few
-        seconds) while the studio goes on."""
+        seconds) while the studio goes on: the run on screen to where it is, when it runs with
+        these settings."""
         try:
             options = self.planning.options()
         except ValueError as exc:
             self.notify("Planner options", str(exc))
             return
-        self.client.add_notification("Drawing the animation", "40 frames, a few seconds",
+        with self._lock:
+            done = self.planning.iterations_on_screen(options)
+        self.client.add_notification("Drawing the animation",
+                                     "40 frames (64 where obstacles move), a few seconds",
                                      auto_close_seconds=4.0)
-        threading.Thread(target=self._send_animation, args=(self.stage.problem, options),
+        threading.Thread(target=self._send_animation, args=(self.stage.problem, options, done),
                          daemon=True, name="studio-gif").start()
 
-    def _send_animation(self, problem, options) -> None:
+    def _send_animation(self, problem, options, iterations: int | None) -> None:
         from app.animate import animation_gif
 
         try:
-            gif = animation_gif(problem, options)
+            gif = animation_gif(problem, options, iterations)
         except ValueError as exc:  # e.g. a robot this steering cannot drive
             self.notify("Animation", str(exc))
             return
