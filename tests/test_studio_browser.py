@@ -383,7 +383,23 @@ def test_dragging_an_obstacle_moves_it_in_the_scenario(browser, ui_url):
     wait_still(page)
     moved = centroid(red(canvas_pixels(page, "09_box_dragged")))
     assert np.allclose(moved - box, [150, 60], atol=25), (box, moved)  # drawn where dropped
+    # Only the selected object shows its gizmo: a click beside the track selects nothing, a
+    # click on the box selects it again.
+    near = gizmo_blue(canvas_pixels(page), moved)
+    page.mouse.click(*(moved + [0, 150]))
+    wait_until(page, lambda img: gizmo_blue(img, moved) < near / 4)
+    assert gizmo_blue(canvas_pixels(page, "09b_nothing_selected"), moved) < near / 4
+    page.mouse.click(*moved)
+    wait_until(page, lambda img: gizmo_blue(img, moved) > near / 2)
+    assert gizmo_blue(canvas_pixels(page), moved) > near / 2
     page.close()
+
+
+def gizmo_blue(img: np.ndarray, near: np.ndarray, radius: int = 70) -> int:
+    """Pixels of the gizmos' blue (54, 142, 226) within ``radius`` pixels of ``near``."""
+    ys, xs = np.mgrid[:img.shape[0], :img.shape[1]]
+    blue = np.abs(img - [54, 142, 226]).sum(axis=2) < 30
+    return int((blue & (np.hypot(xs - near[0], ys - near[1]) <= radius)).sum())
 
 
 def test_a_polygon_clicked_on_the_ground_becomes_an_obstacle(browser, ui_url):

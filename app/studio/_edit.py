@@ -1,6 +1,8 @@
 """Editing the scenario in the scene: obstacles added from the panel or clicked as polygons,
 gizmos that drag and turn obstacles, the start and the goal, and the motion of the selected
-obstacle.
+obstacle. Only the selected object shows its gizmo — a click on an obstacle, the start or the
+goal selects it, a click elsewhere none; an obstacle added is selected — so that a scene with
+many obstacles is not covered in handles.
 
 `Editor` owns the gizmos, the selection, the polygon being clicked and what a ground click does;
 it never changes the scenario itself: it hands a new scenario dict to ``apply`` (the session's,
@@ -15,7 +17,14 @@ import re
 import numpy as np
 
 from app.studio._gizmo import gizmo
-from app.studio._scene import DRAFT_RGB, Z, ground_point, polyline_segments
+from app.studio._scene import (
+    DRAFT_RGB,
+    Z,
+    ground_point,
+    marker_size,
+    obstacle_rings,
+    polyline_segments,
+)
 from planner.obstacles import outline
 
 __all__ = ["Editor", "moved_obstacle", "nearest_s", "parse_waypoints"]
@@ -27,46 +36,70 @@ class Editor:
         ground clicks while `Draw (click the ground)` is ticked."""
         self.scene, self.ui, self.stage = scene, ui, stage
         self._apply, self._track_click, self.notify = apply, track_click, notify
-        self._selected: int | None = None  # the obstacle `Set motion of selected` changes
-        self._gizmos: list = []
+        # What shows its gizmo: "o{i}" (obstacle i, which `Set motion of selected` changes),
+        # "start" or "goal"; None: nothing.
+        self._selected: str | None = None
+        self._gizmos: dict = {}
         self._hidden = False  # projector mode hides the gizmos once a run has started
         self._polygon: list[tuple[float, float]] = []  # corners of a polygon being clicked
         self._click_mode: str | None = None
 
     # -- gizmos: obstacles, start, goal ---------------------------------------------------------
     def place_gizmos(self) -> None:
-        """Gizmos for every obstacle, the start and the goal of the stage's scenario."""
-        for h in self._gizmos:
+        """Gizmos for every obstacle, the start and the goal of the stage's scenario (shown:
+        the selected one's)."""
+        for h in self._gizmos.values():
             h.remove()
-        self._gizmos = []
-        parsed, visible = self.stage.parsed, self._gizmos_visible
+        self._gizmos = {}
+        parsed = self.stage.parsed
         for i, ob in enumerate(parsed.obstacles):
             pose, _ = outline(ob)
-            self._gizmos.append(gizmo(
+            self._gizmos[f"o{i}"] = gizmo(
                 self.scene, f"/edit/o{i}", pose,
                 lambda x, y, yaw, i=i: self.stage.preview_obstacle(i, x, y, yaw),
                 lambda x, y, yaw, i=i: self._commit_obstacle(i, x, y, yaw),
-                rotate=ob.type != "circle", visible=visible))
+                rotate=ob.type != "circle", visible=self._shows(f"o{i}"))
         for key in ("start", "goal"):
-            self._gizmos.append(gizmo(
+            self._gizmos[key] = gizmo(
                 self.scene, f"/edit/{key}", getattr(parsed, key),
                 lambda x, y, yaw, key=key: self.stage.preview_pose(key, x, y, yaw),
                 lambda x, y, yaw, key=key: self._apply(dict(
                     self.stage.scenario,
                     **{key: _round([x, y, math.remainder(yaw, 2 * math.pi)])})),
-                visible=visible))
+                visible=self._shows(key))
 
     def forget_gizmos(self) -> None:
         """The scene was cleared, and the gizmos with it."""
-        self._gizmos = []
+        self._gizmos = {}
 
-    @property
-    def _gizmos_visible(self) -> bool:
-        return bool(self.ui.handles.value) and not self._hidden
+    def _shows(self, key: str) -> bool:
+        return key == self._selected and bool(self.ui.handles.value) and not self._hidden
 
     def show_gizmos(self) -> None:
-        for h in self._gizmos:
-            h.visible = self._gizmos_visible
+        for key, h in self._gizmos.items():
+            h.visible = self._shows(key)
+
+    def select_at(self, p) -> bool:
+        """Select what a ground click at ``p`` (x, y) hits — an obstacle where it is drawn at
+        t = 0, else the start or the goal within a few markers — and show its gizmo; a click
+        on nothing selects nothing. Returns whether it hit something."""
+        from matplotlib.path import Path
+
+        stage = self.stage
+        reach = 4.0 * marker_size(stage.problem.bounds)
+        hits = [f"o{i}" for i, ring in enumerate(obstacle_rings(stage.parsed, 0.0, stage.track))
+                if Path(ring).contains_point(p) or _ring_distance(ring, p) <= reach]
+        hits += [k for k in ("start", "goal")
+                 if math.dist(getattr(stage.parsed, k)[:2], p) <= 2.0 * reach]
+        self._selected = hits[-1] if hits else None  # the topmost: drawn last
+        self.show_gizmos()
+        return bool(hits)
+
+    @property
+    def _obstacle(self) -> int | None:
+        """The selected obstacle's index (None: none is)."""
+        key = self._selected
+        return int(key[1:]) if key is not None and key.startswith("o") else None
 
     def hide_gizmos(self, hidden: bool) -> None:
         """Hide the gizmos (projector mode, once a run has started), or show them again as
@@ -80,7 +113,7 @@ class Editor:
         obstacles = list(stage.scenario["obstacles"])
         obstacles[i] = moved_obstacle(obstacles[i], stage.parsed.obstacles[i], x, y, yaw,
                                       stage.track)
-        self._selected = i
+        self._selected = f"o{i}"
         self._apply(dict(stage.scenario, obstacles=obstacles))
 
     # -- obstacles from the panel ---------------------------------------------------------------
@@ -127,21 +160,24 @@ class Editor:
             ob = dict(ob, motion=motion)
         scenario = self.stage.scenario
         if self._apply(dict(scenario, obstacles=[*scenario["obstacles"], ob])):
-            self._selected = len(self.stage.scenario["obstacles"]) - 1
+            self._selected = f"o{len(self.stage.scenario['obstacles']) - 1}"
+            self.show_gizmos()
 
     def set_motion(self) -> None:
-        """The panel's motion for the selected obstacle (the last one added or dragged)."""
+        """The panel's motion for the selected obstacle (the last one clicked, added or
+        dragged)."""
         obstacles = list(self.stage.scenario["obstacles"])
-        if self._selected is None or self._selected >= len(obstacles):
-            self.notify("No obstacle selected", "add an obstacle or drag one first")
+        i = self._obstacle
+        if i is None or i >= len(obstacles):
+            self.notify("No obstacle selected", "click an obstacle, or add one, first")
             return
         try:
-            motion = self._motion(obstacles[self._selected])
+            motion = self._motion(obstacles[i])
         except ValueError as exc:
             self.notify("Motion not set", str(exc))
             return
-        ob = {k: v for k, v in obstacles[self._selected].items() if k != "motion"}
-        obstacles[self._selected] = ob if motion is None else dict(ob, motion=motion)
+        ob = {k: v for k, v in obstacles[i].items() if k != "motion"}
+        obstacles[i] = ob if motion is None else dict(ob, motion=motion)
         self._apply(dict(self.stage.scenario, obstacles=obstacles))
 
     def _motion(self, ob: dict) -> dict | None:
@@ -194,6 +230,15 @@ class Editor:
         self.scene.add_line_segments("/polygon_draft", seg, DRAFT_RGB, thickness=2.0,
                                      thickness_units="screen", visible=len(seg) > 0)
         self.ui.polygon.label = f"Polygon (click the ground) — {len(pts)} corners"
+
+
+def _ring_distance(ring: np.ndarray, p) -> float:
+    """Distance from point ``p`` to the closed outline ``ring`` (its edges)."""
+    a, b = ring, np.roll(ring, -1, axis=0)
+    ab = b - a
+    u = np.clip(np.einsum("ij,ij->i", np.asarray(p) - a, ab)
+                / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-18), 0.0, 1.0)
+    return float(np.hypot(*(a + u[:, None] * ab - p).T).min())
 
 
 def _round(v) -> list[float]:

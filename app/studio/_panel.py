@@ -19,6 +19,8 @@ STEERINGS = {s.label: s.name for s in planner.STEERINGS.values()}
 TIMINGS = {"constant speed": "constant", "fastest arrival (may wait)": "optimal"}
 MOTIONS = ("static", "velocity", "waypoints", "follow track")
 DEFAULT_BUDGET = 30000  # iterations
+START_HINT = ("**Start here:** press **Run** to grow the tree, or **Step** for one "
+              "iteration; click an obstacle, the start or the goal to move it.")
 SPEEDS = {"max": None, "2000 it/s": 2000.0, "200 it/s": 200.0, "20 it/s": 20.0}
 
 
@@ -150,7 +152,12 @@ def build_panel(gui) -> Panel:
                 hint="Distance planned paths keep from every obstacle and boundary"),
         }
         vehicle_note = gui.add_markdown(APPLIED)
-    with gui.add_folder("Planner") as planner_folder:
+    with gui.add_folder("Planner", order=-8) as planner_folder:
+        # The run controls first: at 1280 × 800 they are in sight without scrolling.
+        run = gui.add_button("Run")
+        pause = gui.add_button("Pause")
+        step = gui.add_button("Step")
+        reset = gui.add_button("Reset")
         planner_name = gui.add_dropdown("Planner", tuple(PLANNERS), initial_value="RRT*")
         steering = gui.add_dropdown("Steering", tuple(STEERINGS))
         timing = gui.add_dropdown(
@@ -182,10 +189,6 @@ def build_panel(gui) -> Panel:
             b_planner = gui.add_dropdown("B: planner", tuple(PLANNERS), initial_value="RRT")
             b_steering = gui.add_dropdown("B: steering", tuple(STEERINGS))
             b_seed = gui.add_number("B: seed", 0, min=0, step=1)
-        run = gui.add_button("Run")
-        pause = gui.add_button("Pause")
-        step = gui.add_button("Step")
-        reset = gui.add_button("Reset")
         replay = gui.add_slider(
             "Replay (iteration)", 0, 1, 1, 0, disabled=True,
             hint="When the run is paused or done: the tree and the best path as they stood "
@@ -208,8 +211,8 @@ def build_panel(gui) -> Panel:
                                             hint="The best path in the TUM raceline layout")
         animation_download = gui.add_button(
             "Download animation (GIF)",
-            hint="This run, seed and budget as 40 frames: the tree growing, its rewires and "
-                 "the best path, for slides")
+            hint="The run on screen as 40 frames: the tree growing, its rewires and the best "
+                 "path, for slides; where obstacles move, 24 more drive the car among them")
         status = gui.add_markdown("Status: ready")
     with gui.add_folder("Metrics"):
         metrics = gui.add_markdown("—")
@@ -226,6 +229,7 @@ def build_panel(gui) -> Panel:
         step_rewire = gui.add_button(
             "Step until a rewire", order=step.order + 0.6,
             hint=f"Single iterations until one rewires the tree (RRT*; {STEP_CAP:,} at most)")
+    gui.add_markdown(START_HINT, order=-9)
     with gui.add_folder("View", order=-10):
         projector = gui.add_checkbox(
             "Projector mode", False,

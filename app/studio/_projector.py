@@ -4,7 +4,8 @@ viser has no font-size setting, so a <style> in the View folder zooms the panel'
 ``zoom`` on the scroll area that holds the style's marker) and the panel is widened by as much:
 it lays out as before, only larger. The Planner folder and EXTEND move to the top of the panel,
 Run, Pause and the Step buttons to the top of the Planner folder (the panel shows rows by their
-``order``), so the run controls are in sight without scrolling at 1280 × 800.
+``order``; the Planner folder and its run controls are first anyway, EXTEND comes up under
+them), so the run controls stay in sight without scrolling at 1280 × 800, zoomed too.
 """
 
 from __future__ import annotations

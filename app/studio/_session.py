@@ -126,12 +126,14 @@ class Session:
         self.client.scene.on_click()(self._scene_click)
 
     def _scene_click(self, ev) -> None:
-        """A click on the ground names the edge there (viser 1.1 reports no hover over the
-        scene), unless the click draws a track point or a polygon corner."""
+        """A click on the ground selects the obstacle, start or goal there (its gizmo shows),
+        else names the edge there (viser 1.1 reports no hover over the scene), unless the
+        click draws a track point or a polygon corner."""
         p = ground_point(ev)
         if p is not None and not self.editor.clicking:
             with self._lock:
-                self.planning.pick(*p)
+                if not self.editor.select_at(p):
+                    self.planning.pick(*p)
 
     def _locked(self, fn) -> None:
         with self._lock:
