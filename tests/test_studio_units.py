@@ -404,6 +404,15 @@ def test_step_labels_never_share_a_place():
     assert x_nearest[0] < 0 < x_new[0]  # on a line: x_nearest's label left, x_new's right
     blocked = labels(None, (np.array([0.3, 0.1, 0.0]), None), rand=np.array([2.0, 0.0, 0.0]))
     assert set(blocked) == {"x_new (blocked)", "x_rand", "x_nearest"}
+    # A big tree's iteration rewires many nodes: only the two that gained most are labelled.
+    edge = np.array([[0.0, 0.0], [0.5, 0.5], [1.0, 1.0]])
+    rewired = [(edge + k, edge - k, 9.0 + k, 8.9 + k - gain)
+               for k, gain in enumerate((0.1, 0.7, 0.3, 0.9, 0.2))]
+    st = {"x_rand": rand, "nearest": nearest, "new": rand.copy(), "blocked": None,
+          "rewired": rewired}
+    texts = [text for _, text, _, _ in step_labels(st, bounds)]
+    assert [t for t in texts if t.startswith(("old", "new"))] == [
+        "old 12.00 m", "new 11.00 m", "old 10.00 m", "new 9.20 m"]
 
 
 def test_step_until_a_rewire_stops_at_one_and_states_the_near_radius_it_used():

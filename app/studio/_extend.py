@@ -66,8 +66,9 @@ def explain(info: StepInfo, star: bool) -> tuple[int, str]:
     if not star:
         return 4, f"x_new (#{info.new}) added with parent x_nearest (#{info.parent})."
     if info.n_rewired:
+        most = " (the scene labels those that gained most)" if info.n_rewired > 2 else ""
         return 7, (f"x_new (#{info.new}) joined via x_min (#{info.parent}); {info.n_rewired} of "
-                   f"{info.n_near} near nodes got cheaper through it and were rewired.")
+                   f"{info.n_near} near nodes got cheaper through it and were rewired{most}.")
     return 6, (f"x_new (#{info.new}) joined via x_min (#{info.parent}), the cheapest of "
                f"{info.n_near} near nodes (r = {info.radius:.2f} m); none got cheaper.")
 

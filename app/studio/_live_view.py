@@ -24,10 +24,12 @@ from app.studio._scene import (
     REVERSE_RGB,
     START_RGB,
     Z,
+    circle_points,
     marker_size,
     metres_per_px,
     path_layers,
     polyline_segments,
+    put_segments,
 )
 from app.studio._tree import EdgeChunks
 from app.studio._worker import FLASH_S, Live
@@ -107,8 +109,7 @@ def legend_html() -> str:
 
 
 def _circle(x: float, y: float, r: float, z: float, n: int = 40) -> np.ndarray:
-    a = np.linspace(0, 2 * math.pi, n, endpoint=False)
-    return polyline_segments(np.column_stack([x + r * np.cos(a), y + r * np.sin(a)]), z, True)
+    return polyline_segments(circle_points(x, y, r, n), z, True)
 
 
 def _edges(pts_list: list[np.ndarray], z: float) -> np.ndarray:
@@ -166,11 +167,15 @@ def place_labels(points: list[tuple[str, str, np.ndarray]], bounds, scale: float
     return out
 
 
+REWIRE_LABELS = 2  # rewired nodes whose old and new costs a step labels
+
+
 def step_labels(st: dict, bounds, scale: float = 1.0, m_per_px: float | None = None
                 ) -> list[tuple[str, str, tuple[float, float], str]]:
     """The step overlay's labels (see `place_labels`): x_rand, x_nearest, x_new (blocked or
-    added) and, for each rewired node, the cost of reaching it by the old and the new edge,
-    at the middle of each."""
+    added) and, for the `REWIRE_LABELS` rewired nodes that got cheapest by most, the cost of
+    reaching each by the old and the new edge, at the middle of each (in a big tree one
+    iteration rewires many: their labels would stack unread; every edge is still drawn)."""
     points = [("step_rand_l", "x_rand", st["x_rand"])]
     if st["nearest"] is not None:
         points.append(("step_nearest_l", "x_nearest", st["nearest"]))
@@ -178,7 +183,8 @@ def step_labels(st: dict, bounds, scale: float = 1.0, m_per_px: float | None = N
         points.insert(0, ("step_new_l", "x_new", st["new"]))
     elif st["blocked"] is not None:
         points.insert(0, ("step_new_l", "x_new (blocked)", st["blocked"][0]))
-    for i, (old, new, was, now) in enumerate(st["rewired"]):
+    most = sorted(st["rewired"], key=lambda r: r[3] - r[2])[:REWIRE_LABELS]
+    for i, (old, new, was, now) in enumerate(most):
         points += [(f"step_was{i}_l", f"old {was:.2f} m", old[len(old) // 2]),
                    (f"step_now{i}_l", f"new {now:.2f} m", new[len(new) // 2])]
     return place_labels(points, bounds, scale, m_per_px)
@@ -222,21 +228,11 @@ class LiveView:
             else:
                 h.font_screen_scale = look.scale
 
-    def _put(self, name: str, seg: np.ndarray, rgb, px: float, z: float | None = None):
+    def _put(self, name: str, seg: np.ndarray, rgb, px: float) -> None:
         """Create or update a line-segments node (hidden when empty); ``px`` at scale 1."""
-        h = self._handles.get(name)
-        if len(seg) == 0:
-            if h is not None:
-                h.visible = False
-            return
-        if h is None:
-            self._px[name] = px
-            self._handles[name] = self.scene.add_line_segments(
-                f"{self.root}/{name}", seg, rgb, thickness=px * self.look.scale,
-                thickness_units="screen")
-        else:
-            h.points = seg
-            h.visible = True
+        self._px.setdefault(name, px)
+        put_segments(self.scene, self._handles, name, f"{self.root}/{name}", seg, rgb,
+                     px * self.look.scale)
 
     def tick(self) -> None:
         if self.replaying:  # the past iteration stays until `live_again`

@@ -15,10 +15,10 @@ import planner
 from planner.obstacles import motion_table, outline, table_offsets
 
 __all__ = ["CURVATURE_RGB", "CUSP_UNDER_RGB", "DRAFT_RGB", "GOAL_RGB", "MOVER_RGB", "OBSTACLE_RGB",
-           "REVERSE_RGB", "START_RGB", "Z", "add_grid", "arc_length", "car_outline", "curvature_colors",
+           "REVERSE_RGB", "START_RGB", "Z", "add_grid", "arc_length", "car_outline", "circle_points", "curvature_colors",
            "cusp_rows", "draw_car", "draw_obstacles", "draw_poses", "draw_track", "fit_camera",
            "ground_point", "marker_size", "metres_per_px", "move_obstacles", "obstacle_rings",
-           "path_layers", "polyline_segments", "reversing",
+           "path_layers", "polyline_segments", "put_segments", "reversing",
            "wxyz_yaw", "yaw_wxyz"]
 
 # Obstacles above the tree: edges pass where a moving obstacle is at other times.
@@ -192,13 +192,32 @@ def car_outline(length: float, width: float) -> np.ndarray:
         length, width]
 
 
+def circle_points(x: float, y: float, r: float, n: int = 40) -> np.ndarray:
+    """(n, 2) points round the circle of radius r about (x, y), counter-clockwise from +x."""
+    a = np.linspace(0, 2 * math.pi, n, endpoint=False)
+    return np.column_stack([x + r * np.cos(a), y + r * np.sin(a)])
+
+
+def put_segments(scene, handles: dict, name: str, path: str, seg: np.ndarray, rgb,
+                 px: float) -> None:
+    """Show ``seg`` as the line-segments node ``path`` kept in ``handles[name]``: created
+    ``px`` screen pixels wide on first use, updated in place after, hidden while empty."""
+    h = handles.get(name)
+    if len(seg) == 0:
+        if h is not None:
+            h.visible = False
+    elif h is None:
+        handles[name] = scene.add_line_segments(path, seg, rgb, thickness=px,
+                                                thickness_units="screen")
+    else:
+        h.points, h.visible = seg, True
+
+
 def _car_ring(vehicle, marker: float) -> np.ndarray:
     """The car's outline about its rear axle, heading +x: see `draw_car`."""
     fp = vehicle.footprint
     if fp is None:
-        a = np.linspace(0, 2 * math.pi, 32, endpoint=False)
-        r = vehicle.radius or 2 * marker
-        return np.column_stack([r * np.cos(a), r * np.sin(a)])
+        return circle_points(0.0, 0.0, vehicle.radius or 2 * marker, 32)
     back = -fp.overhang(vehicle.wheelbase)
     w = fp.width / 2
     return np.array([[back, -w], [back + fp.length, -w], [back + fp.length, w], [back, w]])
@@ -255,8 +274,7 @@ def draw_poses(scene, scenario: planner.Scenario, size: float, root: str = "") -
         frames[name] = scene.add_frame(f"{root}/poses/{name}", show_axes=False, position=(*pose[:2], 0.0),
                         wxyz=yaw_wxyz(pose[2]))
         _fill(scene, f"{root}/poses/{name}/shape", [car_outline(size, 0.5 * size)], Z["pose"], rgb)
-    a = np.linspace(0, 2 * math.pi, 48, endpoint=False)
-    ring = scenario.goal_tolerance.position * np.column_stack([np.cos(a), np.sin(a)])
+    ring = circle_points(0.0, 0.0, scenario.goal_tolerance.position, 48)
     scene.add_line_segments(f"{root}/poses/goal/tol", polyline_segments(ring, Z["pose"], closed=True),
                             GOAL_RGB, thickness=1.5, thickness_units="screen")
     return frames

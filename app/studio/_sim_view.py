@@ -36,6 +36,7 @@ from app.studio._scene import (
     draw_car,
     marker_size,
     polyline_segments,
+    put_segments,
     yaw_wxyz,
 )
 from planner.obstacles import outline
@@ -297,15 +298,7 @@ class SimView:
                       GHOST_Z - 0.0005 * (k + 1), GHOST_RGB, opacity=alpha)
 
     def _put(self, name: str, seg: np.ndarray, rgb, px: float) -> None:
-        h = self._handles.get(name)
-        if h is None:
-            if len(seg):
-                self._handles[name] = self.scene.add_line_segments(
-                    f"/sim/{name}", seg, rgb, thickness=px, thickness_units="screen")
-        elif len(seg):
-            h.points, h.visible = seg, True
-        else:
-            h.visible = False
+        put_segments(self.scene, self._handles, name, f"/sim/{name}", seg, rgb, px)
 
     def tick(self) -> None:
         """Draw what is new since the last tick (called by the session's ticker)."""
