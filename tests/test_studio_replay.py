@@ -91,26 +91,26 @@ def test_recording_stops_with_a_note_past_its_limit():
 
 
 def test_a_lecture_run_is_recorded_whole():
-    """Issue 33, item 3: the studio's default run — the thesis track, RRT* Dubins, its budget
-    of 30 000 iterations at full pace in the worker's batches — is recorded to its last
+    """Issue 33, item 3: the lecturer's run — the thesis track, RRT* Dubins, the old default
+    budget of 30 000 iterations at full pace in the worker's batches — is recorded to its last
     iteration (it stopped at 10 019 once, "a later batch's events were incomplete"), and the
     tree rebuilt there is the live one."""
-    from app.studio._panel import DEFAULT_BUDGET
     from app.studio._scenario import default_scenario
     from app.studio._worker import PlannerWorker
 
     problem = planner.compile_problem(planner.parse_scenario(default_scenario("thesis")))
-    worker = PlannerWorker(problem, planner.PlanOptions(seed=0), budget=DEFAULT_BUDGET)
+    budget = 30_000
+    worker = PlannerWorker(problem, planner.PlanOptions(seed=0), budget=budget)
     try:
         worker.run()
         deadline = time.monotonic() + 60
         while worker.live.state != "done" and time.monotonic() < deadline:
             time.sleep(0.02)
         lane = worker.lanes[0]
-        assert worker.live.state == "done" and lane.tree.iterations == DEFAULT_BUDGET
+        assert worker.live.state == "done" and lane.tree.iterations == budget
         record = lane.record
-        assert record.note is None and record.iterations == DEFAULT_BUDGET
-        assert np.array_equal(record.frame(DEFAULT_BUDGET).parent,
+        assert record.note is None and record.iterations == budget
+        assert np.array_equal(record.frame(budget).parent,
                               lane.tree.snapshot().parent)
     finally:
         worker.stop()

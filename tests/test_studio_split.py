@@ -120,7 +120,8 @@ def test_split_runs_with_the_pace_on_one_clock_and_the_comparison_has_b(session)
     assert len(seen - {(None, None)}) >= 3  # published twice a second over 2 s
     assert all(a == b for a, b in seen)
     assert wait(lambda: _iterations(run) == [400, 400])
-    assert wait(lambda: ui.status.content == "Status: A **done**, B **done**")
+    assert wait(lambda: ui.status.content == "Status: A **done**, B **done** — Run goes on "
+                                             "for 400 iterations more")
 
     assert wait(lambda: "B κ" in [s["label"] for s in run._profiles.curvature.series])
     for chart, a_label, b_label in ((run._profiles.curvature, "A κ", "B κ"),

@@ -547,3 +547,35 @@ def test_pinned_runs_keep_their_colours_and_the_comparison_has_a_row_and_curves_
 
     png = comparison_png(compared, "slalom: compared runs")
     assert Image.open(io.BytesIO(png)).size == (800, 900) and len(png) > 30_000
+
+
+def test_run_on_a_finished_run_goes_on_for_another_budget():
+    """A lecture budget ends while the tree is readable; Run then goes on for as many again,
+    growing the same tree a longer run of that seed grows. RRT, done at its first solution,
+    does not run on."""
+    from app.studio._worker import PlannerWorker
+
+    problem = _problem("slalom")
+    options = planner.PlanOptions(seed=0)
+    worker = PlannerWorker(problem, options, budget=300)
+    try:
+        _run_to_the_end(worker)
+        lane = worker.lanes[0]
+        assert lane.tree.iterations == 300 and worker.can_run_on
+        worker.run()
+        deadline = time.monotonic() + 10
+        while lane.tree.iterations < 600 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        time.sleep(0.1)
+        assert lane.tree.iterations == 600 and worker.budget == 600
+        same = planner.Planner(problem, options)
+        same.step(600)
+        assert np.array_equal(lane.tree.snapshot().parent, same.snapshot().parent)
+    finally:
+        worker.stop()
+    rrt = PlannerWorker(problem, planner.PlanOptions(planner="rrt", seed=0), budget=5000)
+    try:
+        _run_to_the_end(rrt)
+        assert rrt.lanes[0].run.finished and not rrt.can_run_on
+    finally:
+        rrt.stop()

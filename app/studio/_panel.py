@@ -18,7 +18,9 @@ PLANNERS = {"RRT*": "rrtstar", "RRT": "rrt"}
 STEERINGS = {s.label: s.name for s in planner.STEERINGS.values()}
 TIMINGS = {"constant speed": "constant", "fastest arrival (may wait)": "optimal"}
 MOTIONS = ("static", "velocity", "waypoints", "follow track")
-DEFAULT_BUDGET = 30000  # iterations
+# Iterations: a lecture run ends while its tree is readable and the browser fast (past ~10 000
+# nodes software WebGL crawls); Run on a finished run goes on for as many again.
+DEFAULT_BUDGET = 5000
 START_HINT = ("**Start here:** press **Run** to grow the tree, or **Step** for one "
               "iteration; click an obstacle, the start or the goal to move it.")
 SPEEDS = {"max": None, "2000 it/s": 2000.0, "200 it/s": 200.0, "20 it/s": 20.0}

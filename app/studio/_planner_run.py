@@ -414,6 +414,8 @@ class PlannerRun:
         status = "Status: " + ", ".join(
             (f"{name} " if len(lives) > 1 else "") + f"**{live.state}**"
             + (f" — {live.error}" if live.error else "") for name, live in zip("AB", lives))
+        if self.worker.can_run_on:
+            status += f" — Run goes on for {self.worker.run_on:,} iterations more"
         if status != self.ui.status.content:  # GUI updates re-render the panel: only changes
             self.ui.status.content = status
         with self.worker.published:

@@ -204,12 +204,13 @@ class Lane:
 class PlannerWorker:
     """Drives one run (`Lane`), or two on one clock (``other``: the second run's options, the
     two-up split), on its own thread; commanded (run, pause, step, stop) from the UI.
-    ``budget`` is the iterations of each tree."""
+    ``budget`` is the iterations of each tree; Run after it is spent runs on for as many
+    again (a lecture budget ends while the tree is readable, and the run can go on)."""
 
     def __init__(self, problem, options: planner.PlanOptions, budget: int,
                  rate: float | None = None, other: planner.PlanOptions | None = None) -> None:
         self.lanes = [Lane(problem, o) for o in (options, other) if o is not None]
-        self.budget = budget
+        self.budget = self.run_on = budget
         self.rate = rate  # iterations per second, None: as fast as it goes
         self._cmds: queue.Queue[str] = queue.Queue()
         # Held while the runs' metrics are replaced and while the UI reads them: the numbers
@@ -257,6 +258,13 @@ class PlannerWorker:
         """Whether the run has iterated."""
         return self.lanes[0].stepped > 0
 
+    @property
+    def can_run_on(self) -> bool:
+        """Whether the runs stopped at the budget alone, so that Run would go on (not RRT at
+        its first solution, not a planner's error)."""
+        return self._done() and any(not lane.run.finished and lane.live.error is None
+                                    for lane in self.lanes)
+
     # -- the thread ------------------------------------------------------------------------------
     def _loop(self) -> None:
         running, batch = False, 16
@@ -268,6 +276,8 @@ class PlannerWorker:
             if cmd == "stop":
                 return
             if cmd == "run":
+                if self.can_run_on:
+                    self.budget += self.run_on
                 running = not self._done()
             elif cmd == "pause":
                 running = False
