@@ -280,3 +280,30 @@ def test_runs_that_failed_before(name, rate, timing, seed):
     s = run.summary
     assert s["collisions"] == 0 and s["reached_goal"], s
 
+
+
+def test_along_the_plan_the_guard_counts_how_far_the_car_is_off_it():
+    """A crowd_warehouse variant (speeds × 1.25, 10 Hz, seed 2): lagging outside a tight turn,
+    the car drifted 0.28 m off its plan into a shelf while the guard, checking the plan's rows,
+    said follow. A post 0.25 m clear of the plan: followed when the car is on it, not when it
+    is 0.3 m off (then the clearances along the plan count that much less)."""
+    from planner.sim.control import Reference
+    from planner.sim.guard import FOLLOW, guard
+    from planner.sim.vehicle import Limits
+
+    world = build_world((0, 0, 10, 10), 0.2, [(6.0, 5.55, 0.1, -1)], [], [])
+    x = np.arange(0.0, 10.0, 0.05)
+    ref = Reference(np.column_stack([x, np.full_like(x, 5.0), np.zeros((len(x), 2)),
+                                     np.ones(len(x))]))
+    limits = Limits(wheelbase=0.44, max_steer=math.radians(26), max_steer_rate=math.pi,
+                    max_speed=1.5, max_accel=1.0)
+
+    def decide(off: float):
+        # At 1 m/s 0.8 m before the post: braking (0.5 m) cannot stop short of it.
+        return guard(world, 0.0, (5.2, 5.0, 0.0, 1.0, 0.0), limits, ref, 104, ref.length, 1.0,
+                     0.1, 0.9021, True, off=off)
+
+    on = decide(0.0)
+    assert on.manoeuvre.name == FOLLOW and not on.danger
+    off = decide(0.3)
+    assert off.manoeuvre.name != FOLLOW or off.danger, off

@@ -96,9 +96,10 @@ class _Rollouts:
 
     def __init__(self, world: World, margin: float, state, limits: Limits,
                  ref: Reference | None, i: int, stop_s: float, rho: float,
-                 done_s: float = math.inf) -> None:
+                 done_s: float = math.inf, off: float = 0.0) -> None:
         self.world, self.margin, self.limits, self.ref, self.stop_s = (world, margin, limits,
                                                                       ref, stop_s)
+        self.off = off  # how far the car is from the plan beyond the margin (along the plan)
         likely = world.m_grow.copy()
         likely[:, 1:3] = 0.0  # no growth: each mover where its sensed velocity takes it
         self.likely = world._replace(m_grow=likely)
@@ -135,7 +136,7 @@ class _Rollouts:
         poses[:, :2] = ref.rows[j, :2] + u[:, None] * (ref.rows[j + 1, :2] - ref.rows[j, :2])
         poses[:, 2] = np.where(u < 0.5, ref.rows[j, 2], ref.rows[j + 1, 2])
         end = int(np.searchsorted(ss, self.done_s)) + 1  # the run ends in the goal
-        return self._clear(poses[:end], vs[:end])
+        return self._clear(poses[:end], vs[:end], self.off)
 
     def free(self, m: Manoeuvre) -> Outcome:
         """Clear time of an open-loop manoeuvre: steering towards ``m.steer`` at the rate
@@ -160,25 +161,26 @@ class _Rollouts:
         poses[:, 2] = th
         return self._clear(poses, vs)
 
-    def _clear(self, poses: np.ndarray, vs: np.ndarray) -> Outcome:
+    def _clear(self, poses: np.ndarray, vs: np.ndarray, off: float = 0.0) -> Outcome:
         """The time of the first sample pair that may hide a contact (inf: none): with the
         movers as believed (grown, with the margin), with the static world as it is; if there
-        is one, also with the movers' likely futures."""
+        is one, also with the movers' likely futures. ``off``: the car may be this far from
+        the poses (it is off the plan it tracks), so every clearance counts that much less."""
         n = len(poses)
         samples = np.zeros((n, 6))
         samples[:, :3] = poses
         drive = np.abs(vs[:-1]) * self.reach * STEP
         samples[:, 5] = math.nan  # static obstacles only
-        static = _unsure(path_clearances(self.world, samples, True) + self.margin, drive)
+        static = _unsure(path_clearances(self.world, samples, True) + self.margin - off, drive)
         samples[:, 5] = self.t[:n]
         closing = drive + self.closing[:n - 1]
-        bad = np.flatnonzero(_unsure(path_moving_clearances(self.world, samples), closing)
+        bad = np.flatnonzero(_unsure(path_moving_clearances(self.world, samples) - off, closing)
                              | static)
         if len(bad) == 0:
             return Outcome(math.inf, True)
         k = bad[0]
-        likely = np.flatnonzero(_unsure(path_moving_clearances(self.likely, samples), closing)
-                                | static)
+        likely = np.flatnonzero(_unsure(path_moving_clearances(self.likely, samples) - off,
+                                        closing) | static)
         j = likely[0] if len(likely) else k
         return Outcome(float(self.t[k]), max(abs(vs[j]), abs(vs[j + 1])) < 1e-9,
                        float(self.t[likely[0]]) if len(likely) else math.inf)
@@ -195,7 +197,7 @@ def _toward(v: float, want: float, step: float) -> float:
 
 def guard(world: World, margin: float, state, limits: Limits, ref: Reference | None, i: int,
           stop_s: float, cruise: float, commit: float, rho: float, reverse: bool,
-          stuck: bool = False, done_s: float = math.inf) -> Decision:
+          stuck: bool = False, done_s: float = math.inf, off: float = 0.0) -> Decision:
     """The car's manoeuvre until the next decision, ``commit`` s from now.
 
     ``state``: (x, y, θ, v, δ) now; ``ref``/``i``: the plan and the car's row on it (None: no
@@ -205,9 +207,12 @@ def guard(world: World, margin: float, state, limits: Limits, ref: Reference | N
     ``stuck``: the car has stood, not by plan, for a while — a forward-only planner finds no
     way round an obstacle right in front, so it backs off a little if that is clear;
     ``done_s``: the arc where the plan enters the goal and the run ends (inf: none) — a goal in
-    a stream of traffic is reached, not stood in, so the check along the plan ends there.
+    a stream of traffic is reached, not stood in, so the check along the plan ends there;
+    ``off``: how far the car is from its row on the plan beyond what the margin allows: the
+    checks along the plan count it off every clearance (a car that lags outside a tight
+    turn stays outside it), the open-loop manoeuvres start from where the car is.
     """
-    r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho, done_s)
+    r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho, done_s, off)
     tried: list[tuple[Outcome, Manoeuvre]] = []
     if stuck and reverse:  # a forward-only plan finds no way on: make room behind
         m = Manoeuvre(BACK_OFF, -0.5 * cruise, steer=0.0)

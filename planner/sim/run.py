@@ -175,10 +175,11 @@ def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertain
     margin = GUARD_MARGIN * s.margin
     margin = margin if clearance(believed, state[0], state[1], 0.0) > margin else 0.0
     i = ref.project(state[0], state[1])[0] if ref is not None else 0
-    if ref is not None and math.dist(state[:2], ref.rows[i, :2]) > OFF_PLAN:
+    off = math.dist(state[:2], ref.rows[i, :2]) if ref is not None else 0.0
+    if off > OFF_PLAN:
         ref = None  # the car is not where the plan is: checks along it would be fiction
     return guard(inflated(believed, margin), margin, state, limits, ref, i, stop_s, cruise,
-                 commit, problem.rho, s.reverse, stuck, done_s)
+                 commit, problem.rho, s.reverse, stuck, done_s, max(off - margin, 0.0))
 
 
 def _lap_counter(scenario: Scenario, problem: Problem, s: SimSettings, load_track):
