@@ -307,3 +307,29 @@ def test_along_the_plan_the_guard_counts_how_far_the_car_is_off_it():
     assert on.manoeuvre.name == FOLLOW and not on.danger
     off = decide(0.3)
     assert off.manoeuvre.name != FOLLOW or off.danger, off
+
+
+def test_along_the_plan_a_car_still_backing_up_brakes_off_it_first():
+    """In a crowd_overtake variant the car backed away from an oncoming disc and the guard, told
+    to follow a new plan, modelled it standing at the plan's start. A car at −1 m/s brakes 0.5 m
+    further back first: with a post 0.55 m behind it, following is not clear; with the post
+    1 m behind, it is."""
+    from planner.sim.control import Reference
+    from planner.sim.guard import FOLLOW, guard
+    from planner.sim.vehicle import Limits
+
+    x = np.arange(5.0, 10.0, 0.05)
+    ref = Reference(np.column_stack([x, np.full_like(x, 5.0), np.zeros((len(x), 2)),
+                                     np.ones(len(x))]))
+    limits = Limits(wheelbase=0.44, max_steer=math.radians(26), max_steer_rate=math.pi,
+                    max_speed=1.5, max_accel=1.0)
+
+    def decide(behind: float):
+        world = build_world((0, 0, 10, 10), 0.2, [(5.0 - behind, 5.0, 0.1, -1)], [], [])
+        return guard(world, 0.0, (5.0, 5.0, 0.0, -1.0, 0.0), limits, ref, 0, ref.length, 1.0,
+                     0.1, 0.9021, True)
+
+    far = decide(1.0)
+    assert far.manoeuvre.name == FOLLOW and not far.danger
+    near = decide(0.55)
+    assert near.manoeuvre.name != FOLLOW or near.danger, near

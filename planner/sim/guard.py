@@ -118,7 +118,8 @@ class _Rollouts:
 
     def along(self, cap: float, hold: float) -> Outcome:
         """Clear time of: along the plan at speed ``cap`` for ``hold`` s, then braking; never
-        past ``stop_s``."""
+        past ``stop_s``. A car still backing up brakes first, off the plan where its reverse
+        takes it, and then counts how far that is from its row as off the plan."""
         ref, a = self.ref, self.limits.max_accel
         v, s = self.v, self.s0
         vs, ss = np.empty(self.n), np.empty(self.n)
@@ -128,15 +129,20 @@ class _Rollouts:
             want = cap if tk < hold else 0.0
             want = min(want, math.sqrt(2.0 * a * max(self.stop_s - s, 0.0)))
             nv = _toward(v, want, a * STEP)
-            s += 0.5 * (v + nv) * STEP
+            s += 0.5 * (max(v, 0.0) + max(nv, 0.0)) * STEP
             v = nv
         j = np.clip(np.searchsorted(ref.s, ss) - 1, 0, len(ref.s) - 2)
         u = np.clip((ss - ref.s[j]) / np.maximum(ref.s[j + 1] - ref.s[j], 1e-12), 0.0, 1.0)
         poses = np.empty((self.n, 3))
         poses[:, :2] = ref.rows[j, :2] + u[:, None] * (ref.rows[j + 1, :2] - ref.rows[j, :2])
         poses[:, 2] = np.where(u < 0.5, ref.rows[j, 2], ref.rows[j + 1, 2])
+        off = np.full(self.n, self.off)
+        back = int(np.argmax(vs >= 0.0))  # the sample where the car has stopped backing
+        if back:
+            poses[:back + 1] = self._poses(vs, np.full(self.n, self.steer))[:back + 1]
+            off[back + 1:] += math.dist(poses[back, :2], poses[back + 1, :2])
         end = int(np.searchsorted(ss, self.done_s)) + 1  # the run ends in the goal
-        return self._clear(poses[:end], vs[:end], self.off)
+        return self._clear(poses[:end], vs[:end], off[:end])
 
     def free(self, m: Manoeuvre) -> Outcome:
         """Clear time of an open-loop manoeuvre: steering towards ``m.steer`` at the rate
@@ -149,23 +155,28 @@ class _Rollouts:
         for k in range(self.n):
             vs[k] = v
             v = _toward(v, m.speed if k * STEP < m.hold else 0.0, lim.max_accel * STEP)
-        # Exact arcs per step (commands held over it, as the car does).
+        return self._clear(self._poses(vs, steers), vs)
+
+    def _poses(self, vs: np.ndarray, steers: np.ndarray) -> np.ndarray:
+        """The car's poses from where it is, at these speeds and steering angles per sample:
+        exact arcs per step (commands held over it, as the car does)."""
         v_mid = 0.5 * (vs[:-1] + vs[1:])
-        dth = v_mid * STEP * np.tan(steers[:-1]) / lim.wheelbase
+        dth = v_mid * STEP * np.tan(steers[:-1]) / self.limits.wheelbase
         th = self.th + np.concatenate([[0.0], np.cumsum(dth)])
         chord = v_mid * STEP * np.sinc(dth / (2.0 * np.pi))
         mid = th[:-1] + 0.5 * dth
-        poses = np.empty((self.n, 3))
+        poses = np.empty((len(vs), 3))
         poses[:, 0] = self.x + np.concatenate([[0.0], np.cumsum(chord * np.cos(mid))])
         poses[:, 1] = self.y + np.concatenate([[0.0], np.cumsum(chord * np.sin(mid))])
         poses[:, 2] = th
-        return self._clear(poses, vs)
+        return poses
 
-    def _clear(self, poses: np.ndarray, vs: np.ndarray, off: float = 0.0) -> Outcome:
+    def _clear(self, poses: np.ndarray, vs: np.ndarray, off=0.0) -> Outcome:
         """The time of the first sample pair that may hide a contact (inf: none): with the
         movers as believed (grown, with the margin), with the static world as it is; if there
-        is one, also with the movers' likely futures. ``off``: the car may be this far from
-        the poses (it is off the plan it tracks), so every clearance counts that much less."""
+        is one, also with the movers' likely futures. ``off`` (m, or per sample): the car may be
+        this far from the poses (it is off the plan it tracks), so every clearance counts that
+        much less."""
         n = len(poses)
         samples = np.zeros((n, 6))
         samples[:, :3] = poses
