@@ -62,8 +62,9 @@ POLISH_SHARE = 0.2
 # whatever the search has spent so far (at the first solution that can be a few dozen).
 POLISH_FREE = 5000
 # What `iterate` returns: the batch ran; the tree is full (grow it and call again); a polish
-# is due (call `polish`, then `iterate` for the rest of the batch).
-RAN, FULL, POLISH_DUE = range(3)
+# is due (call `polish`, then `iterate` for the rest of the batch); the event buffers might not
+# hold the next iteration's near set and rewires (grow them and call again).
+RAN, FULL, POLISH_DUE, EVENTS_FULL = range(4)
 # Event row columns (only written when the event buffers are non-empty); EV_XN..EV_THN: where
 # Steer ended, x_new whether the motion to it was free or not.
 EV_ITER, EV_XR, EV_YR, EV_THR, EV_NEAREST, EV_NEW, EV_PARENT, EV_NEAR_START, EV_NEAR_END, \
@@ -644,8 +645,9 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
 
 @njit(cache=True)
 def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int:
-    """Run up to ``n_iter`` iterations; returns RAN, FULL (grow the tree and call again) or
-    POLISH_DUE (call `polish`: apart, so that its time can be measured).
+    """Run up to ``n_iter`` iterations; returns RAN, FULL (grow the tree and call again),
+    POLISH_DUE (call `polish`: apart, so that its time can be measured) or EVENTS_FULL (grow
+    the event buffers and call again: a batch's events are always complete).
 
     Every iteration draws one sample, whether or not it adds a node (as OMPL counts them).
     """
@@ -662,6 +664,11 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
     for _ in range(n_iter):
         if tree.cnt[N] >= tree.pose.shape[0]:
             status = FULL
+            break
+        # An iteration's near set, and so its rewires, name at most every node.
+        if record and min(ev.near.shape[0] - ev.cnt[1],
+                          ev.rewires.shape[0] - ev.cnt[2]) < tree.cnt[N]:
+            status = EVENTS_FULL
             break
         if P[STAR] == 0.0 and tree.cnt[BEST] >= 0:
             break  # RRT ends at its first solution, whatever the batch size

@@ -28,7 +28,6 @@ from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points, path_poi
 
 __all__ = ["Planner", "Result", "checked_world", "warm_up"]
 
-POLISHED_PER_BATCH = 4096  # nodes a batch's events can name as added by polishing
 
 @dataclass
 class Result:
@@ -114,9 +113,8 @@ class Planner:
         self._P = P
         zero = np.zeros(5)
         K.add_node(self._tree, P, *problem.start, 0.0, -1, zero.astype(np.int8), zero)
-        self._no_events = K.Events(np.zeros((0, K.EV_COLS)), np.zeros(0, np.int64),
-                                   np.zeros((0, 4), np.int64), np.zeros(0, np.int64),
-                                   np.zeros(4, np.int64))
+        self._no_events = _event_buffers(0, 0, 0, 0)
+        self._events = self._no_events  # the listeners' buffers, grown as needed, reused
         self._listeners: list[Callable[[TreeEvents], None]] = []
         self._clock = _Clock()
         self._compute_time = 0.0
@@ -211,7 +209,7 @@ class Planner:
     # -- running -----------------------------------------------------------------------------
     def step(self, iterations: int = 1) -> None:
         """Advance by ``iterations`` samples (grows the tree arrays as needed)."""
-        events = self._event_buffers(iterations) if self._listeners else self._no_events
+        events = self._recording(iterations) if self._listeners else self._no_events
         done_before = self.iterations
         target = done_before + iterations
         t0 = time.perf_counter()
@@ -221,9 +219,13 @@ class Planner:
             if status == K.FULL:
                 self._tree = K.grown(self._tree, 2 * self._tree.pose.shape[0])
             elif status == K.POLISH_DUE:
+                # Polishing adds at most as many nodes as the tree has room for.
+                events = self._events = _room(events, polished=self._tree.pose.shape[0])
                 started = time.perf_counter()
                 K.polish(self._tree, self._world, self._P, events)
                 self._polish_time += time.perf_counter() - started
+            elif status == K.EVENTS_FULL:
+                events = self._events = _room(events, near=2 * self.nodes)
         took = time.perf_counter() - t0
         self._compute_time += took
         self._note_progress(done_before, took)
@@ -232,11 +234,11 @@ class Planner:
             for listener in self._listeners:
                 listener(batch)
 
-    def _event_buffers(self, iterations: int) -> K.Events:
-        near_cap = max(64, 64 * iterations)
-        return K.Events(np.zeros((iterations, K.EV_COLS)), np.zeros(near_cap, np.int64),
-                        np.zeros((max(64, 16 * iterations), 4), np.int64),
-                        np.zeros(POLISHED_PER_BATCH, np.int64), np.zeros(4, np.int64))
+    def _recording(self, iterations: int) -> K.Events:
+        """The event buffers, emptied, with a row for each of ``iterations``."""
+        ev = self._events = _room(self._events, rows=iterations, near=64 * iterations)
+        ev.cnt[:] = 0
+        return ev
 
     def _note_progress(self, iterations_before: int, batch_s: float) -> None:
         """Time-stamp the batch's improvements, which the kernel records by iteration: inside
@@ -388,6 +390,26 @@ class Planner:
             max_abs_curvature=float(np.abs(path[:, 3]).max()) if solved else None,
             cost_over_time=list(self._clock.cost_over_time), path=path,
             timed=self.problem.timed, options=self.options, length_m=self.best_cost)
+
+
+def _event_buffers(rows: int, near: int, rewires: int, polished: int) -> K.Events:
+    return K.Events(np.zeros((rows, K.EV_COLS)), np.zeros(near, np.int64),
+                    np.zeros((rewires, 4), np.int64), np.zeros(polished, np.int64),
+                    np.zeros(4, np.int64))
+
+
+def _room(ev: K.Events, rows: int = 0, near: int = 0, polished: int = 0) -> K.Events:
+    """``ev`` (its contents kept) with room for ``rows`` rows, and ``near`` more near-set
+    entries and as many rewires, and ``polished`` more polished nodes than it holds."""
+    used = ev.cnt
+    want = (rows, used[1] + near, used[2] + near, used[3] + polished)
+    have = (len(ev.rows), len(ev.near), len(ev.rewires), len(ev.polished))
+    if all(h >= w for h, w in zip(have, want)):
+        return ev
+    grown = _event_buffers(*(h if h >= w else max(w, 2 * h) for h, w in zip(have, want)))
+    for old, new in zip(ev, grown):
+        new[:len(old)] = old
+    return grown
 
 
 def _named(ev: K.Events) -> TreeEvents:

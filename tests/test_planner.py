@@ -109,6 +109,24 @@ def test_events_report_every_iteration_and_cost_nothing_without_listener():
     assert all(snap.parent[n] == p for n, p in last.items())
 
 
+def test_events_name_every_near_node_and_rewire_however_many():
+    """A replay draws what the events name. With k = 30·log n nearest (OMPL's default is
+    5.5), one iteration's near set outgrows the 64 entries a one-iteration batch was given:
+    the kernel stops the batch, the buffers grow, and nothing is dropped."""
+    problem = planner.compile_problem(planner.parse_scenario(scenario_dict("slalom")))
+    run = planner.Planner(problem, planner.PlanOptions(seed=2, k_rrt=30.0))
+    seen = []
+    run.add_listener(seen.append)
+    for _ in range(300):
+        before = run.nodes
+        run.step(1)
+        e = seen[-1]
+        if e.new[0] >= 0:  # exactly the k nearest of the nodes there were
+            assert len(e.near_of(0)) == min(before, math.ceil(30.0 * math.log(before + 1)))
+    assert max(len(e.near_of(0)) for e in seen) > 64
+    assert sum(len(e.rewires) for e in seen) == run.rewires
+
+
 def test_unsolvable_scenario_reports_unsolved():
     scn = scenario_dict("open_field")
     scn["obstacles"].append({"type": "circle", "center": [19, 19], "radius": 0.1})

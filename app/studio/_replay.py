@@ -10,9 +10,9 @@ in order, so "as of N" is a prefix of each). The best path is kept as the worker
 the iteration its cost was reached: between two improvements inside one batch of the running
 planner the record has the cost but not the path (`Frame.path_iteration` says which is shown).
 
-Recording stops, with a note, past `MAX_NODES` nodes or when a batch's events miss something
-(the kernel caps a batch's rewire and polished-node lists): the slider then covers the
-iterations recorded before.
+Recording stops, with a note, past `MAX_NODES` nodes, or if a batch's events ever missed
+something (they should not: the kernel ends a batch early and its buffers grow rather than drop
+an event): the slider then covers the iterations recorded before.
 """
 
 from __future__ import annotations
@@ -122,7 +122,8 @@ class TreeRecord:
             if (not np.array_equal(added, np.arange(n, n + len(added))) or n + len(added)
                     != nodes or m + len(ev.rewires) != rewires):
                 self.note = (f"Replay records the first {self.iterations:,} iterations (a "
-                             "later batch's events were incomplete)")
+                             "later batch's events did not name every node and rewire, as "
+                             "the planner's always should: please report this run)")
                 return
             when = np.maximum.accumulate(np.concatenate([[self._iter[n - 1]], when]))[1:]
             self._iter, self._first = _grown(self._iter, nodes), _grown(self._first, nodes)
