@@ -16,7 +16,7 @@ from app.studio._edit import moved_obstacle, parse_waypoints
 from app.studio._extend import RRT_LINES, STAR_LINES, StepInfo, explain, render
 from app.studio._panel import STEERINGS
 from app.studio._scenario import default_scenario
-from app.studio._tree import EdgeChunks
+from app.studio._tree import CHUNK, FULL_CHUNKS, OLD_EDGES, SEG, EdgeChunks
 from planner.problem import resolve_track
 
 
@@ -25,8 +25,10 @@ def _problem(name: str = "thesis"):
 
 
 def _run_to_the_end(worker) -> None:
-    """Run the worker until its budget is spent (10 s at most), and a moment longer."""
-    worker.run()
+    """Run the worker until its budget is spent (10 s at most), and a moment longer. (Run on
+    a run that has spent its budget would go on for as much again.)"""
+    if worker.live.state not in ("running", "done"):
+        worker.run()
     deadline = time.monotonic() + 10
     while worker.live.state != "done" and time.monotonic() < deadline:
         time.sleep(0.01)
@@ -82,6 +84,18 @@ def test_chunks_send_the_tail_every_time_and_rewired_chunks_a_few_at_a_time():
     assert ch.take_rewired(5) == []
 
 
+def test_a_tree_growing_faster_than_the_tail_budget_is_sent_behind_and_catches_up():
+    ch = EdgeChunks(seg=2, chunk=4)
+    line = np.array([[0, 0], [1, 0], [2, 0]], float)
+    for node in range(10):  # chunks 0, 1 full; chunk 2 the tail
+        ch.set(node, line + node)
+    assert [c for c, _ in ch.take_tail(8)] == [0]  # one chunk's pieces per call
+    ch.set(10, line)
+    assert [c for c, _ in ch.take_tail(8)] == [1]
+    assert [(c, len(seg)) for c, seg in ch.take_tail(8)] == [(2, 6)]  # caught up: 3 nodes
+    assert ch.take_tail(8) == []
+
+
 def test_chunk_messages_stay_the_same_size_however_big_the_tree():
     ch = EdgeChunks(seg=4, chunk=256)
     pts = np.zeros((5, 2))
@@ -91,6 +105,31 @@ def test_chunk_messages_stay_the_same_size_however_big_the_tree():
         if node % 256 == 255:
             sizes.append(sum(seg.nbytes for _, seg in ch.take_tail()))
     assert max(sizes) == min(sizes) == 256 * 4 * 2 * 3 * 4
+
+
+def test_the_drawn_tree_stays_bounded_however_big_it_grows():
+    """What the browser holds, tick after tick, while a tree grows to 30 000 nodes: the newest
+    chunks in full, older edges as chords, and past OLD_EDGES of them every k-th; always under
+    the bound, and every node's chunk is drawn."""
+    ch = EdgeChunks()
+    curve = np.column_stack([np.linspace(0, 1, SEG + 1), np.linspace(0, 1, SEG + 1) ** 2])
+    browser: dict[int, np.ndarray] = {}
+    for node in range(30_000):
+        ch.set(node, curve + node)
+        if node % 50 == 0 or node == 29_999:  # a UI tick: the tail, then the re-levelled
+            for c, seg in ch.take_tail() + ch.take_rewired(4):
+                browser[c] = seg
+    while ch.pending_rewired():
+        browser.update(ch.take_rewired(4))
+    drawn = sum(len(seg) for seg in browser.values())
+    assert drawn <= FULL_CHUNKS * CHUNK * SEG + OLD_EDGES, drawn
+    assert len(browser) == ch.chunks
+    newest, oldest = browser[ch.chunks - 1], browser[0]
+    assert len(newest) == (30_000 % CHUNK or CHUNK) * SEG  # the tail keeps its curves
+    # The oldest chunk: every second edge (29 000 old nodes > OLD_EDGES), each as its chord.
+    assert np.allclose(oldest[:, 0, :2], curve[0] + np.arange(0, CHUNK, 2)[:, None])
+    assert np.allclose(oldest[:, 1, :2], curve[-1] + np.arange(0, CHUNK, 2)[:, None])
+    assert np.allclose(ch.get(0), curve)  # clicks and replay still see the full edge
 
 
 def test_extend_explains_what_each_iteration_really_did():
@@ -207,7 +246,7 @@ def test_a_run_that_ends_between_metric_updates_still_shows_its_last_numbers():
 def test_timing_optimal_shows_the_schedule_and_drive_car_stands_still_through_its_wait():
     """The level crossing: the path shown is the run's result, the car waiting for the train;
     Drive car holds the pose of the wait's start while the scene time runs on."""
-    from app.studio._planner_run import _metrics_md, pose_at_time
+    from app.studio._run_text import metrics_md, pose_at_time
     from app.studio._worker import PlannerWorker
 
     problem = planner.compile_problem(planner.load_scenario("train"))
@@ -220,12 +259,12 @@ def test_timing_optimal_shows_the_schedule_and_drive_car_stands_still_through_it
     assert worker.live.error is None and worker.lanes[0].run.detour.iterations == 1500
     assert m["waited_s"] > 10.0 and m["arrival_s"] == pytest.approx(path[-1, 5])
     assert f"| arrives after | {m['arrival_s']:.3g} s (waits {m['waited_s']:.3g} s) |" in (
-        _metrics_md(m))
+        metrics_md(m))
     # When it came, in the planner's own terms (a paced run takes longer to watch).
     first = m["first_solution_iteration"]
     assert 0 < first <= 1500 and (f"| first solution | iteration {first:,} "
                                   f"({m['time_to_first_solution_s']:.3g} s of planning) |"
-                                  ) in _metrics_md(m)
+                                  ) in metrics_md(m)
     still = np.flatnonzero(np.all(np.diff(path[:, :3], axis=0) == 0.0, axis=1))  # i to i + 1
     assert np.diff(path[:, 5])[still].sum() == pytest.approx(m["waited_s"])
     for i in still:
@@ -387,13 +426,17 @@ def test_a_negative_budget_is_refused_with_the_models_message():
 
 def test_step_labels_never_share_a_place():
     from app.studio._live_view import step_labels
+    from app.studio._worker import Rewired, Step
 
     bounds = (-10.0, -10.0, 10.0, 10.0)  # markers of 0.12
     rand, nearest = np.array([1.0, 1.0, 0.0]), np.array([0.0, 0.0, 0.0])
 
+    def step(new, blocked=None, rand=rand, rewired=()):
+        return Step(None, True, planner.PlanOptions(), rand, nearest, new, blocked, None,
+                    np.zeros((0, 3)), 0.0, rewired)
+
     def labels(new, blocked=None, rand=rand):
-        st = {"x_rand": rand, "nearest": nearest, "new": new, "blocked": blocked,
-              "rewired": []}
+        st = step(new, blocked, rand)
         return {text: (where, anchor) for _, text, where, anchor in step_labels(st, bounds)}
 
     assert list(labels(rand.copy())) == ["x_new = x_rand", "x_nearest"]
@@ -406,10 +449,9 @@ def test_step_labels_never_share_a_place():
     assert set(blocked) == {"x_new (blocked)", "x_rand", "x_nearest"}
     # A big tree's iteration rewires many nodes: only the two that gained most are labelled.
     edge = np.array([[0.0, 0.0], [0.5, 0.5], [1.0, 1.0]])
-    rewired = [(edge + k, edge - k, 9.0 + k, 8.9 + k - gain)
-               for k, gain in enumerate((0.1, 0.7, 0.3, 0.9, 0.2))]
-    st = {"x_rand": rand, "nearest": nearest, "new": rand.copy(), "blocked": None,
-          "rewired": rewired}
+    rewired = tuple(Rewired(edge + k, edge - k, 9.0 + k, 8.9 + k - gain)
+                    for k, gain in enumerate((0.1, 0.7, 0.3, 0.9, 0.2)))
+    st = step(rand.copy(), rewired=rewired)
     texts = [text for _, text, _, _ in step_labels(st, bounds)]
     assert [t for t in texts if t.startswith(("old", "new"))] == [
         "old 12.00 m", "new 11.00 m", "old 10.00 m", "new 9.20 m"]
@@ -431,13 +473,13 @@ def test_step_until_a_rewire_stops_at_one_and_states_the_near_radius_it_used():
         step, nodes = worker.live.step, worker.lanes[0].run.nodes
     finally:
         worker.stop()
-    info = step["info"]
-    assert step["until"] == ("rewire", info.iteration, "found") and info.n_rewired > 0
-    assert info.new == nodes - 1 and all(now < was for *_, was, now in step["rewired"])
-    note = near_note(info, step["options"])
+    info = step.info
+    assert step.until == ("rewire", info.iteration, "found") and info.n_rewired > 0
+    assert info.new == nodes - 1 and all(r.now < r.was for r in step.rewired)
+    note = near_note(info, step.options)
     term = 2.0 * (math.log(nodes) / nodes) ** (1 / 3)
-    assert term < step["options"].eps and info.radius == pytest.approx(term)
-    assert note.endswith(f"= min({term:.2f}, {step['options'].eps:.2f}) = {info.radius:.2f} m "
+    assert term < step.options.eps and info.radius == pytest.approx(term)
+    assert note.endswith(f"= min({term:.2f}, {step.options.eps:.2f}) = {info.radius:.2f} m "
                          f"(n = {nodes} nodes, d = 3: x, y, θ).")
 
 
@@ -579,3 +621,37 @@ def test_run_on_a_finished_run_goes_on_for_another_budget():
         assert rrt.lanes[0].run.finished and not rrt.can_run_on
     finally:
         rrt.stop()
+
+
+def test_a_gizmo_drag_previews_under_the_session_lock():
+    """The ticker moves the obstacles along the scene clock holding the session's lock; a
+    gizmo's drag previews on viser's event loop. A preview waits for the lock, and a dragged
+    moving obstacle then goes on along its motion from where it was dragged to."""
+    import threading
+
+    from planner.obstacles import table_offsets
+    from tests._studio_tab import open_tab, wait
+
+    with open_tab() as session:
+        stage = session.stage
+        session.sources.load_scenario(
+            json.loads(planner.bundled_scenario_path("crossing").read_text()))
+        assert wait(lambda: stage.parsed is not None and stage.parsed.name == "crossing")
+        i = next(k for k, (_, _, table) in enumerate(stage._drawn) if table is not None)
+        frame, _, table = stage._drawn[i]
+        before = tuple(frame.position)
+        previewed = threading.Event()
+
+        def drag() -> None:
+            stage.preview_obstacle(i, 1.0, 2.0, 0.0)
+            previewed.set()
+
+        with session._lock:  # as the ticker holds it while it draws
+            threading.Thread(target=drag, daemon=True).start()
+            assert not previewed.wait(0.3)
+            assert tuple(frame.position) == before
+        assert previewed.wait(5)
+        with session._lock:
+            stage.show_time(1.5)  # the ticker, at a later scene time
+            dx, dy = table_offsets(table, 1.5)[0]
+            assert tuple(frame.position[:2]) == pytest.approx((1.0 + dx, 2.0 + dy))

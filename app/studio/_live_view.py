@@ -31,8 +31,8 @@ from app.studio._scene import (
     polyline_segments,
     put_segments,
 )
-from app.studio._tree import EdgeChunks
-from app.studio._worker import FLASH_S, Live
+from app.studio._tree import CHUNK, SEG, EdgeChunks
+from app.studio._worker import FLASH_S, Live, Step
 
 __all__ = ["LEGEND", "LiveView", "Look", "edge_label", "legend_html", "place_labels",
            "step_labels"]
@@ -64,12 +64,17 @@ SIDES = ((1, 1), (1, -1), (-1, 1), (-1, -1))  # a label's quadrant off its point
 # and height.
 LABEL_CHAR_PX, LABEL_PAD_PX, LABEL_H_PX = 6.5, 8.0, 18.0
 MARKER_PX = 6.0  # a marker's size in the fitted view: the scale when the camera is not known
-REWIRED_PER_SLOW_TICK = 4
-SLOW_EVERY = 5  # ticks
-# Rewire flashes (up to 96 edges, 0.6 s each) change every tick while RRT* rewires: re-sent every
-# other tick with every other point of the edge, a quarter of the bytes of a full redraw.
-FLASH_EVERY = 2  # ticks
+# The tree goes out in one burst every TREE_EVERY ticks (5 a second): the browser's cost is
+# per update it renders, more than per byte (Chromium with software WebGL drew 1.5 frames/s
+# while a chunk went out every tick, and fell to 1.5 from 20 with ten small chunks a second).
+# A burst holds at most 4 chunks of new nodes (a tree growing faster is drawn behind the
+# planner and catches up), 4 chunks' worth of rewired or re-levelled ones, and the rewire
+# flashes (0.6 s each, the newest 32, every other point of the edge): at most 1.2 MB/s.
+TAIL_PIECES = 4 * CHUNK * SEG
+REWIRED_PER_TICK = 4
+TREE_EVERY = 5  # ticks
 FLASH_STRIDE = 2
+FLASHES_DRAWN = 32
 
 
 @dataclass(frozen=True)
@@ -170,20 +175,20 @@ def place_labels(points: list[tuple[str, str, np.ndarray]], bounds, scale: float
 REWIRE_LABELS = 2  # rewired nodes whose old and new costs a step labels
 
 
-def step_labels(st: dict, bounds, scale: float = 1.0, m_per_px: float | None = None
+def step_labels(st: Step, bounds, scale: float = 1.0, m_per_px: float | None = None
                 ) -> list[tuple[str, str, tuple[float, float], str]]:
     """The step overlay's labels (see `place_labels`): x_rand, x_nearest, x_new (blocked or
     added) and, for the `REWIRE_LABELS` rewired nodes that got cheapest by most, the cost of
     reaching each by the old and the new edge, at the middle of each (in a big tree one
     iteration rewires many: their labels would stack unread; every edge is still drawn)."""
-    points = [("step_rand_l", "x_rand", st["x_rand"])]
-    if st["nearest"] is not None:
-        points.append(("step_nearest_l", "x_nearest", st["nearest"]))
-    if st["new"] is not None:
-        points.insert(0, ("step_new_l", "x_new", st["new"]))
-    elif st["blocked"] is not None:
-        points.insert(0, ("step_new_l", "x_new (blocked)", st["blocked"][0]))
-    most = sorted(st["rewired"], key=lambda r: r[3] - r[2])[:REWIRE_LABELS]
+    points = [("step_rand_l", "x_rand", st.x_rand)]
+    if st.nearest is not None:
+        points.append(("step_nearest_l", "x_nearest", st.nearest))
+    if st.new is not None:
+        points.insert(0, ("step_new_l", "x_new", st.new))
+    elif st.blocked is not None:
+        points.insert(0, ("step_new_l", "x_new (blocked)", st.blocked[0]))
+    most = sorted(st.rewired, key=lambda r: r.now - r.was)[:REWIRE_LABELS]
     for i, (old, new, was, now) in enumerate(most):
         points += [(f"step_was{i}_l", f"old {was:.2f} m", old[len(old) // 2]),
                    (f"step_now{i}_l", f"new {now:.2f} m", new[len(new) // 2])]
@@ -239,11 +244,9 @@ class LiveView:
             return
         self._ticks += 1
         chunks = self.live.chunks
-        sends = chunks.take_tail()
-        if self._ticks % SLOW_EVERY == 0:
-            sends += chunks.take_rewired(REWIRED_PER_SLOW_TICK)
-        self._send_chunks(sends)
-        if self._ticks % FLASH_EVERY == 0:
+        if self._ticks % TREE_EVERY == 0:  # one burst: the browser renders it once
+            self._send_chunks(chunks.take_tail(TAIL_PIECES)
+                              + chunks.take_rewired(REWIRED_PER_TICK))
             self._flashes()
         if self.live.best_version != self._seen["best"]:
             self._seen["best"] = self.live.best_version
@@ -303,7 +306,7 @@ class LiveView:
 
     def _flashes(self) -> None:
         now = time.monotonic()
-        fl = [f for f in list(self.live.flashes) if now - f[0] < FLASH_S]
+        fl = [f for f in list(self.live.flashes) if now - f[0] < FLASH_S][-FLASHES_DRAWN:]
         if not fl and "flash_old" not in self._handles:
             return
         self._put("flash_old", _edges([f[1][::FLASH_STRIDE] for f in fl], Z["flash"]),
@@ -311,7 +314,7 @@ class LiveView:
         self._put("flash_new", _edges([f[2][::FLASH_STRIDE] for f in fl], Z["flash"]),
                   REWIRE_NEW_RGB, 2.5)
 
-    def _step_overlay(self, st: dict | None) -> None:
+    def _step_overlay(self, st: Step | None) -> None:
         """x_rand, x_nearest, x_new (or where a blocked Steer ended, and its motion), the near
         radius and nodes, the chosen parent edge, the rewired edges old and new; labelled."""
         for name in [n for n in self._handles if n.startswith("step_")]:
@@ -319,27 +322,27 @@ class LiveView:
         if st is None:
             return
         m, z = self.marker, Z["step"]
-        xr = st["x_rand"]
+        xr = st.x_rand
         self._put("step_rand", _circle(xr[0], xr[1], m, z, 12), RAND_RGB, 3.0)
-        if st["nearest"] is not None:
-            self._put("step_nearest", _circle(*st["nearest"][:2], m, z, 12), NEAREST_RGB, 3.0)
-        if st["blocked"] is not None:
-            end, pts = st["blocked"]
+        if st.nearest is not None:
+            self._put("step_nearest", _circle(*st.nearest[:2], m, z, 12), NEAREST_RGB, 3.0)
+        if st.blocked is not None:
+            end, pts = st.blocked
             # A dark line under the red one keeps it visible across a red obstacle.
             self._put("step_blocked_under", _edges([pts], z - 1e-4), (30, 30, 30), 7.0)
             self._put("step_blocked", _edges([pts], z), BLOCKED_RGB, 3.5)
             self._put("step_blocked_end", _circle(end[0], end[1], m, z, 12), BLOCKED_RGB, 3.0)
-        if st["new"] is not None:
-            nx, ny = st["new"][:2]
+        if st.new is not None:
+            nx, ny = st.new[:2]
             self._put("step_new", _circle(nx, ny, m, z, 12), NEW_RGB, 3.0)
-            if st["radius"] > 0 and math.isfinite(st["radius"]):
-                self._put("step_radius", _circle(nx, ny, st["radius"], z, 64), NEAR_RGB, 1.5)
-            near = [_circle(x, y, 0.4 * m, z, 8) for x, y, _ in st["near"]]
+            if st.radius > 0 and math.isfinite(st.radius):
+                self._put("step_radius", _circle(nx, ny, st.radius, z, 64), NEAR_RGB, 1.5)
+            near = [_circle(x, y, 0.4 * m, z, 8) for x, y, _ in st.near]
             self._put("step_near", np.concatenate(near) if near else near, NEAR_RGB, 2.0)
-            self._put("step_parent", _edges([st["parent_edge"]], z), NEW_RGB, 5.0)
-        self._put("step_was", _edges([r[0] for r in st["rewired"]], z - 1e-4), REWIRE_OLD_RGB,
+            self._put("step_parent", _edges([st.parent_edge], z), NEW_RGB, 5.0)
+        self._put("step_was", _edges([r.old for r in st.rewired], z - 1e-4), REWIRE_OLD_RGB,
                   1.5)
-        self._put("step_rewired", _edges([r[1] for r in st["rewired"]], z), REWIRE_NEW_RGB, 4.0)
+        self._put("step_rewired", _edges([r.new for r in st.rewired], z), REWIRE_NEW_RGB, 4.0)
         view = metres_per_px(self.camera) if self.camera is not None else None
         for label in step_labels(st, self.bounds, self.look.scale, view):
             self._label(*label)

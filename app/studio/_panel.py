@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+
+import numpy as np
 
 import planner
 import tracks
@@ -10,9 +13,11 @@ from app.studio._extend import FIRST_NOTE, render
 from app.studio._live_view import legend_html
 from app.studio._vehicle import APPLIED, FOOTPRINTS
 from app.studio._worker import STEP_CAP
+from planner.sim.control import CONTROLLERS
+from planner.sim.run import GUARD_CODES
 
 __all__ = ["DEFAULT_BUDGET", "MOTIONS", "PLANNERS", "SPEEDS", "STEERINGS", "TIMINGS", "Panel",
-           "build_panel"]
+           "SimControls", "build_panel", "build_sim_controls"]
 
 PLANNERS = {"RRT*": "rrtstar", "RRT": "rrt"}
 STEERINGS = {s.label: s.name for s in planner.STEERINGS.values()}
@@ -242,3 +247,55 @@ def build_panel(gui) -> Panel:
                                           "stand out")
         projector_css = gui.add_html("")
     return Panel(**{k: v for k, v in locals().items() if k != "gui"})
+
+
+@dataclass
+class SimControls:
+    """The `Simulate` folder's handles."""
+
+    rate: object
+    controller: object
+    noise: object
+    seed: object
+    simulate: object
+    stop: object
+    status: object
+    metrics: object
+    steering: object
+    lateral: object
+    safety: object
+
+
+def build_sim_controls(gui) -> SimControls:
+    """The `Simulate` folder (`SimView` drives it)."""
+    with gui.add_folder("Simulate"):
+        rate = gui.add_number("Replanning rate (Hz)", 30.0, min=1.0, max=100.0, step=1.0)
+        controller = gui.add_dropdown("Controller", CONTROLLERS, initial_value=CONTROLLERS[0])
+        noise = gui.add_number("Noise σ (m)", 0.0, min=0.0, max=1.0, step=0.01)
+        seed = gui.add_number("Simulation seed", 0, min=0, step=1)
+        simulate_ = gui.add_button("Simulate")
+        stop = gui.add_button("Stop")
+        status = gui.add_markdown("Simulation: ready")
+        metrics = gui.add_markdown("—")
+        t = np.array([0.0, 1.0])
+        nan = np.full(2, math.nan)
+        common = {"aspect": 2.0, "legend": {"show": True}, "scales": {"x": {"time": False}}}
+        steering = gui.add_uplot(
+            (t, nan, nan), ({"label": "t (s)"},
+                            {"label": "δ commanded (deg)", "stroke": "#e8542f", "width": 1.5},
+                            {"label": "δ actual (deg)", "stroke": "#4a90e2", "width": 2.0}),
+            title="Steering: commanded (Soll) vs actual (Ist)", **common)
+        lateral = gui.add_uplot(
+            (t, nan), ({"label": "t (s)"},
+                       {"label": "lateral error (cm)", "stroke": "#8e44ad", "width": 1.5}),
+            title="Lateral error to the path being followed", **common)
+        codes = " ".join(f"{v} {k}" for k, v in GUARD_CODES.items())
+        safety = gui.add_uplot(
+            (t, nan, nan, nan),
+            ({"label": "t (s)"},
+             {"label": "speed (m/s)", "stroke": "#2e8b57", "width": 1.5},
+             {"label": f"guard ({codes})", "stroke": "#ff7800", "width": 1.5},
+             {"label": "contact (1 moving, 2 at rest)", "stroke": "#e61e1e", "width": 2.0}),
+            title="Safety timeline: speed, what the guard did, contacts", **common)
+    return SimControls(rate, controller, noise, seed, simulate_, stop, status, metrics,
+                       steering, lateral, safety)

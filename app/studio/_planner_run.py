@@ -10,7 +10,6 @@ The pins stay until `Clear pins` or another track.
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
@@ -20,22 +19,22 @@ import planner
 import tracks
 from app.raceline import path_raceline, raceline_limits
 from app.studio._compare import CURRENT, SPLIT_B, Pins, Run, settings_words
-from app.studio._extend import FIRST_NOTE, explain, near_note, render, until_note
+from app.studio._drive import DrivenCar
+from app.studio._extend import FIRST_NOTE, render
 from app.studio._live_view import LiveView, Look
 from app.studio._panel import DEFAULT_BUDGET, PLANNERS, SPEEDS, STEERINGS, TIMINGS
 from app.studio._plots import Profiles
+from app.studio._replay_slider import ReplaySlider
+from app.studio._run_text import extend_html, metrics_md
 from app.studio._scenario import goal_fraction
-from app.studio._scene import draw_car, marker_size, yaw_wxyz
+from app.studio._scene import marker_size
 from app.studio._split import Split
-from app.studio._tree import EdgeChunks
 from app.studio._worker import PlannerWorker
 from planner.validation import describe
 
-__all__ = ["PlannerRun", "pose_at_time"]
+__all__ = ["PlannerRun"]
 
-SPLIT_REPLAY = "Replay: one run at a time (leave the split to replay)"
 PLOT_S = 1.0  # profile plots redraw at most this often (uPlot re-renders all of it)
-OLD_EDGES = 300_000  # replayed edges a tree no longer holds, kept at most (a few 10 MB)
 
 
 class PlannerRun:
@@ -43,23 +42,24 @@ class PlannerRun:
         self.gui, self.scene, self.ui = gui, scene, ui
         self.stage, self.clock, self.notify = stage, clock, notify
         self.worker: PlannerWorker | None = None
-        self._driving = False  # the car shows the best path at the scene time
+        self.car = DrivenCar(scene, clock, lambda: (self.worker.live.best_path
+                                                    if self.worker is not None else None))
         self._view: LiveView | None = None
         self.split = Split(scene)  # run B's half of the scene
         self._choosing_b = False  # `choose_split` sets B's controls
         self.look = Look()  # how it draws the run (`set_look`)
         self._profiles: Profiles | None = None
-        self._car = None
         self._shown: dict = {}  # versions of the worker's record already shown
         self.pins = Pins(scene)
         self._track = None  # the pins' track
-        self._old_edges: dict[tuple[int, int], np.ndarray] = {}  # (node, parent): its points
+        self.replayer = ReplaySlider(ui)
 
     def new_track(self, track: tracks.Track, vehicle) -> None:
         """The stage cleared the scene (the run's drawing went with it): profile plots of the
         new track's centreline, for a vehicle of this size. Pins stay on the same track (a
         car's settings changed: they compare it with the car before)."""
-        self._view = self._car = None
+        self._view = None
+        self.car.forget()
         self.split.forget()
         if self._profiles is not None:
             for h in self._profiles.handles:
@@ -167,12 +167,9 @@ class PlannerRun:
             self.split.show(self.stage, tuple(f"{n}: {' · '.join(settings_words(o))}"
                                               for n, o in (("A", options), ("B", other))),
                             self.worker.lanes[1].live, self.look, camera)
-        self._shown = {"metrics": (), "best": (), "step": (), "cost": (), "replay": -1}
-        self._old_edges.clear()
-        self._driving = False
-        if self._car is not None:
-            self._car.remove()
-            self._car = None
+        self._shown = {"metrics": (), "best": (), "step": (), "cost": ()}
+        self.replayer = ReplaySlider(self.ui)
+        self.car.stop()
         self.ui.metrics.content = "—"
         self.ui.extend.content = render(None, FIRST_NOTE, star=options.planner == "rrtstar")
         self._show_pins_legend()
@@ -233,68 +230,15 @@ class PlannerRun:
 
     # -- replay --------------------------------------------------------------------------------
     def replay(self, n: int) -> None:
-        """The replay slider at iteration n: the tree and the best path as they stood then, on
-        a paused or finished run (the worker's `TreeRecord`); at its last iteration, the run.
-        Not in the split (the slider is disabled there)."""
-        if self._view is None or self.worker.live.state == "running" or self.splitting:
-            return
-        record = self.worker.record
-        if n >= record.iterations:
-            self.replay_end()
-            return
-        frame = record.frame(n)
-        edges = EdgeChunks(capacity=1)
-        edges.fill(self._replayed_edges(frame))
-        self._view.replay(edges, frame.path)
-        self.ui.replay_note.content = _replay_md(frame, record)
+        """The replay slider at iteration n (`ReplaySlider.show`); not while the run runs, nor
+        in the split (the slider is disabled there)."""
+        if self._view is not None and self.worker.live.state != "running" and not self.splitting:
+            self.replayer.show(n, self.worker, self._view)
 
     def replay_end(self) -> None:
         """Back to the run from a replay: the slider at its end."""
-        if self._view is None or not self._view.replaying:
-            return
-        self._view.live_again()
-        end = self.worker.record.iterations
-        self.ui.replay_note.content = _replay_md(None, self.worker.record)
-        self.ui.replay.value = end
-
-    def _replayed_edges(self, frame) -> np.ndarray:
-        """The edges of ``frame``'s tree: as drawn live where a node's parent is still the
-        one it had then, else the steering between the two poses (a rewire replaced the edge;
-        kept for the next frames). A record that stopped steers every edge (the live tree
-        went on from where it ends)."""
-        record, n = self.worker.record, frame.nodes
-        pts = self.worker.live.chunks.points(n)
-        if record.note is None:
-            final = record.frame(record.iterations).parent[:n]
-            old = np.flatnonzero(frame.parent != final)
-        else:
-            old = np.arange(1, n)
-        poses = record.poses(n)
-        if len(self._old_edges) + len(old) > OLD_EDGES:
-            self._old_edges.clear()
-        for node in old.tolist():
-            up = int(frame.parent[node])
-            edge = self._old_edges.get((node, up))
-            if edge is None:
-                edge = self._old_edges[node, up] = self.worker.steer_points(poses[up],
-                                                                             poses[node])
-            pts[node] = edge
-        return pts
-
-    def _tick_replay(self, live) -> None:
-        """The slider follows the record: usable once the run is paused or done, at its end
-        while the run is shown."""
-        slider, end = self.ui.replay, self.worker.record.iterations
-        usable = live.state != "running" and end > 0 and not self.splitting
-        if slider.disabled == usable:
-            slider.disabled = not usable
-        if self._view.replaying or self._shown["replay"] == end:
-            return
-        self._shown["replay"] = end
-        slider.max = max(end, 1)
-        slider.value = end
-        self.ui.replay_note.content = (SPLIT_REPLAY if self.splitting
-                                       else _replay_md(None, self.worker.record))
+        if self._view is not None:
+            self.replayer.end(self.worker, self._view)
 
     # -- compare runs --------------------------------------------------------------------------
     def current(self) -> Run | None:
@@ -364,42 +308,15 @@ class PlannerRun:
 
     # -- the car -------------------------------------------------------------------------------
     def drive(self) -> None:
-        """`Drive car`: the scene clock restarts at 0 and plays; the car and the moving
-        obstacles share it, so what the planner avoided in time is what you see avoided."""
-        path = self.worker.live.best_path
-        if path is None or not len(path):
+        """`Drive car`: the car drives the best path from the scene time 0."""
+        if not self.car.drive(self.stage.problem):
             self.notify("No path yet", "press Run until a path to the goal is found")
-            return
-        self._driving = True
-        self.clock.reach(path[-1, 5])
-        self.show_car(0.0)  # the clock may be at 0 already: then setting it draws nothing
-        self.clock.play_from_start()
-
-    @property
-    def drive_end(self) -> float | None:
-        """When the driving car reaches the goal (the scene clock loops there); None when no
-        car drives."""
-        path = self.worker.live.best_path if self._driving else None
-        return float(path[-1, 5]) if path is not None and len(path) else None
 
     def show_time(self, t: float) -> None:
         """The scene clock at t: run B's moving obstacles (the stage moves A's) and the driving
         car."""
         self.split.show_time(t)
-        self.show_car(t)
-
-    def show_car(self, t: float) -> None:
-        """The driving car where the best path is at time t."""
-        path = self.worker.live.best_path if self.worker is not None else None
-        if not self._driving or path is None or not len(path):
-            return
-        x, y, th = pose_at_time(path, t)
-        if self._car is None:
-            problem = self.stage.problem
-            self._car = draw_car(self.scene, "/live/car", problem.scenario.vehicle,
-                                 marker_size(problem.bounds), (x, y, th))
-        self._car.position = (x, y, 0.0)
-        self._car.wxyz = yaw_wxyz(th)
+        self.car.show(t)
 
     # -- the ticker ----------------------------------------------------------------------------
     def tick(self) -> None:
@@ -410,7 +327,7 @@ class PlannerRun:
         for view in (self._view, self.split.view):
             if view is not None:
                 view.tick()
-        self._tick_replay(lives[0])
+        self.replayer.tick(self.worker, self._view, self.splitting)
         status = "Status: " + ", ".join(
             (f"{name} " if len(lives) > 1 else "") + f"**{live.state}**"
             + (f" — {live.error}" if live.error else "") for name, live in zip("AB", lives))
@@ -423,14 +340,14 @@ class PlannerRun:
             metrics = [live.metrics for live in lives]
         if versions != self._shown["metrics"]:
             self._shown["metrics"] = versions
-            self.ui.metrics.content = _metrics_md(*metrics)
+            self.ui.metrics.content = metrics_md(*metrics)
             self._show_pins_legend()  # this run's numbers and difference
         if time.monotonic() - self._shown.get("plotted", 0.0) > PLOT_S:
             self._plot(lives)
         steps = tuple(live.step_version for live in lives)
         if steps != self._shown["step"] and lives[0].step is not None:
             self._shown["step"] = steps
-            self.ui.extend.content = _extend_html([live.step for live in lives])
+            self.ui.extend.content = extend_html([live.step for live in lives])
 
     def _plot(self, lives: list) -> None:
         """The profiles when a best path changed, the cost curves when the metrics did (they
@@ -446,77 +363,3 @@ class PlannerRun:
         if costs != self._shown["cost"]:
             self._shown["cost"], self._shown["plotted"] = costs, now
             self._profiles.show_cost(*self._compared_now())
-
-
-def _extend_html(steps: list) -> str:
-    """The EXTEND panel after a step: run A's line highlighted and explained; in the split, a
-    line more on what run B's same iteration did."""
-    step = steps[0]
-    line, note = explain(step["info"], step["star"])
-    notes = [until_note(*step["until"]), f"Iteration {step['info'].iteration}: {note}",
-             near_note(step["info"], step["options"])]
-    if len(steps) > 1 and steps[1] is not None:
-        notes.append(f"B, its iteration {steps[1]['info'].iteration}: "
-                     f"{explain(steps[1]['info'], steps[1]['star'])[1]}")
-    return render(line, *notes, star=step["star"])
-
-
-def pose_at_time(path: np.ndarray, t: float) -> tuple[float, float, float]:
-    """The pose (x, y, θ) on a path's rows at time t, by their t column: through a wait (rows of
-    one pose, t rising) the car stands still."""
-    k = int(np.searchsorted(path[:, 5], t).clip(0, len(path) - 1))
-    return tuple(float(v) for v in path[k, :3])
-
-
-def _replay_md(frame, record) -> str:
-    """The replay's line under its slider: the iteration shown of those recorded, its nodes
-    and best cost (None: the run itself)."""
-    end = record.iterations
-    if frame is None:
-        text = (f"Replay: iteration {end:,} of {end:,} (the run)" if end
-                else "Replay: pause or finish a run")
-    else:
-        cost = "no path yet" if frame.cost is None else f"best cost {frame.cost:.4g} m"
-        text = (f"Replay: iteration {frame.iteration:,} of {end:,} · {frame.nodes:,} nodes · "
-                f"{cost}")
-        if frame.cost is not None and frame.path_iteration != frame.cost_iteration:
-            text += (" (no path drawn for it)" if frame.path is None else
-                     f" (the path drawn is the one of iteration {frame.path_iteration:,}: "
-                     "the cost fell again inside one of the planner's batches)")
-    return text + (f". {record.note}." if record.note else "")
-
-
-def _fmt(v, unit: str = "", digits: int = 3) -> str:
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "—"
-    return f"{v:.{digits}g}{unit}" if isinstance(v, float) else f"{v}{unit}"
-
-
-def _metric_cells(m: dict) -> dict[str, str]:
-    """One run's column of the metrics table, by row name."""
-    if not m:
-        return {}
-    arrival = {} if m.get("arrival_s") is None else {  # timing optimal, once solved
-        "arrives after": f"{_fmt(m['arrival_s'], ' s')} (waits {_fmt(m['waited_s'], ' s')})"}
-    return {"iterations": f"{m['iterations']}", "nodes": f"{m['nodes']}",
-            "rewires": f"{m['rewires']}",
-            # The planner's own time, not the paced run's: at 20 it/s a 0.01 s solution takes
-            # seconds to watch, so its iteration comes first.
-            "first solution": "—" if m.get("first_solution_iteration") is None else (
-                f"iteration {m['first_solution_iteration']:,} "
-                f"({_fmt(m['time_to_first_solution_s'], ' s')} of planning)"),
-            "cost": _fmt(m["cost"], " m", 4), **arrival,
-            "min clearance": _fmt(m["min_clearance_m"], " m"),
-            "iterations/s": _fmt(m["iterations_per_s"], "", 4)}
-
-
-def _metrics_md(*runs: dict) -> str:
-    """The metrics table: a column per run, headed A and B in the split."""
-    cols = [_metric_cells(m) for m in runs]
-    if not any(cols):
-        return "—"
-    rows = [f"| {k} | " + " | ".join(c.get(k, "—") for c in cols) + " |"
-            for k in dict.fromkeys(k for c in cols for k in c)]
-    if len(cols) == 1:  # the first row heads the table
-        return "\n".join([rows[0], "|---|---|", *rows[1:]])
-    return "\n".join(["| | A | B |", "|---|---|---|", *rows])

@@ -16,8 +16,8 @@ The session wires the controls to them and does what spans parts: a new track or
 resets the rest. UI callbacks only change state and restart workers; the ticker thread pushes
 the workers' progress to the browser at ~25 Hz, holding the lock, as does every callback while
 it replaces what the ticker draws: directly (`_locked`), or through `apply_scenario` and
-`set_track`, which compile outside the lock and take it to swap the drawing (a gizmo's drag
-goes that way, so its own ``on_update`` needs no lock).
+`set_track`, which compile outside the lock and take it to swap the drawing (a gizmo's release
+goes that way; its drag previews take the lock in `Stage`).
 """
 
 from __future__ import annotations
@@ -55,7 +55,7 @@ class Session:
         self._lock = threading.RLock()
         self._closed = False
         self.clock = SceneClock(u.scene_time, u.play, max_step=4 * TICK_S)
-        self.stage = Stage(client, self.clock)
+        self.stage = Stage(client, self.clock, self._lock)
         self.planning = PlannerRun(client.gui, client.scene, u, self.stage, self.clock,
                                    self.notify)
         self.sources = Sources(client, u, self.stage, api_url, self.set_track, self.notify)
@@ -302,7 +302,7 @@ class Session:
         self.editor.hide_gizmos(self.projector.on and self.planning.started)
         self.planning.tick()
         self.sim.tick()
-        self.clock.advance(self.planning.drive_end)
+        self.clock.advance(self.planning.car.end)
 
     def close(self) -> None:
         self._closed = True

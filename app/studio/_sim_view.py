@@ -21,7 +21,6 @@ import dataclasses
 import math
 import threading
 import time
-from dataclasses import dataclass
 
 import numpy as np
 import shapely
@@ -30,6 +29,7 @@ from pydantic import ValidationError
 import planner
 from app.simulation import SimOptions
 from app.studio._live_view import PATH_RGB, TREE_RGB
+from app.studio._panel import build_sim_controls
 from app.studio._scene import (
     Z,
     _fill,
@@ -39,15 +39,15 @@ from app.studio._scene import (
     put_segments,
     yaw_wxyz,
 )
+from app.studio._tree import edge_segments
 from planner.obstacles import outline
 from planner.sim import SimSettings
-from planner.sim.control import CONTROLLERS
 from planner.sim.predict import Lanes, believed_offsets
 from planner.sim.run import GUARD_CODES, Frame, simulate
 from planner.sim.sensing import known_motions, mover_index
 from planner.validation import describe
 
-__all__ = ["SimControls", "SimView", "build_controls"]
+__all__ = ["SimView"]
 
 TREE_S = 0.5  # s between tree extractions (≈20 µs per edge, on the simulation's thread)
 SLOW_S = 0.5  # s between plot and metrics refreshes (uPlot redraws every point)
@@ -65,57 +65,6 @@ EVENT_RGB = {"collision": (230, 30, 30), "stall": (240, 170, 0), "brake": (255, 
              "wait": (60, 160, 255), "evade": (200, 40, 200), "back-off": (120, 90, 200)}
 LOOK_AHEAD_S = (0.5, 1.0, 1.5)  # s: grown predictions drawn, fading with the look-ahead
 GROWN_OPACITY = (0.22, 0.14, 0.08)
-
-
-@dataclass
-class SimControls:
-    """The `Simulate` folder's handles."""
-
-    rate: object
-    controller: object
-    noise: object
-    seed: object
-    simulate: object
-    stop: object
-    status: object
-    metrics: object
-    steering: object
-    lateral: object
-    safety: object
-
-
-def build_controls(gui) -> SimControls:
-    with gui.add_folder("Simulate"):
-        rate = gui.add_number("Replanning rate (Hz)", 30.0, min=1.0, max=100.0, step=1.0)
-        controller = gui.add_dropdown("Controller", CONTROLLERS, initial_value=CONTROLLERS[0])
-        noise = gui.add_number("Noise σ (m)", 0.0, min=0.0, max=1.0, step=0.01)
-        seed = gui.add_number("Simulation seed", 0, min=0, step=1)
-        simulate_ = gui.add_button("Simulate")
-        stop = gui.add_button("Stop")
-        status = gui.add_markdown("Simulation: ready")
-        metrics = gui.add_markdown("—")
-        t = np.array([0.0, 1.0])
-        nan = np.full(2, math.nan)
-        common = {"aspect": 2.0, "legend": {"show": True}, "scales": {"x": {"time": False}}}
-        steering = gui.add_uplot(
-            (t, nan, nan), ({"label": "t (s)"},
-                            {"label": "δ commanded (deg)", "stroke": "#e8542f", "width": 1.5},
-                            {"label": "δ actual (deg)", "stroke": "#4a90e2", "width": 2.0}),
-            title="Steering: commanded (Soll) vs actual (Ist)", **common)
-        lateral = gui.add_uplot(
-            (t, nan), ({"label": "t (s)"},
-                       {"label": "lateral error (cm)", "stroke": "#8e44ad", "width": 1.5}),
-            title="Lateral error to the path being followed", **common)
-        codes = " ".join(f"{v} {k}" for k, v in GUARD_CODES.items())
-        safety = gui.add_uplot(
-            (t, nan, nan, nan),
-            ({"label": "t (s)"},
-             {"label": "speed (m/s)", "stroke": "#2e8b57", "width": 1.5},
-             {"label": f"guard ({codes})", "stroke": "#ff7800", "width": 1.5},
-             {"label": "contact (1 moving, 2 at rest)", "stroke": "#e61e1e", "width": 2.0}),
-            title="Safety timeline: speed, what the guard did, contacts", **common)
-    return SimControls(rate, controller, noise, seed, simulate_, stop, status, metrics,
-                       steering, lateral, safety)
 
 
 class _Stopped(Exception):
@@ -193,8 +142,9 @@ class _Run:
             # Whose: the car's when it moved into it (the speed held over the tick before).
             moving = abs(self._v) > 1e-9
             self._contact = 1 if moving else 2
-            self.events.append((f.t, x, y, "collision", f"clearance {self.clearance:.2f} m, "
-                                f"{'car moving' if moving else 'car at rest'}"))
+            self.events.append((f.t, x, y, "collision",
+                                (f"clearance {self.clearance:.2f} m, "
+                                 f"{'car moving' if moving else 'car at rest'}")))
         self._colliding = self.clearance <= 0.0
         if f.guard != self._guard and f.guard in EVENT_RGB:
             self.events.append((f.t, x, y, f.guard, f"at {f.v:.2f} m/s"))
@@ -215,10 +165,7 @@ def _tree_segments(tree: planner.TreeSnapshot) -> np.ndarray:
     if tree.nodes < 2:
         return np.zeros((0, 2, 3), np.float32)
     pts = np.stack([tree.edge_points(i, EDGE_PIECES) for i in range(1, tree.nodes)])
-    seg = np.zeros((len(pts), EDGE_PIECES, 2, 3), np.float32)
-    seg[:, :, 0, :2], seg[:, :, 1, :2] = pts[:, :-1], pts[:, 1:]
-    seg[..., 2] = Z["tree"]
-    return seg.reshape(-1, 2, 3)
+    return edge_segments(pts, Z["tree"])
 
 
 class SimView:
@@ -227,7 +174,7 @@ class SimView:
 
     def __init__(self, gui, scene, clock) -> None:
         self.scene, self.clock = scene, clock
-        self.ui = build_controls(gui)
+        self.ui = build_sim_controls(gui)
         self.run: _Run | None = None
         self._handles: dict[str, object] = {}
         self._movers = np.zeros(0, np.int64)  # per scenario obstacle: its motion (-1: static)

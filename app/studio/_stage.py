@@ -3,6 +3,10 @@
 `Stage` is the only writer of them; the editor, the planner run and the simulation read
 ``track``, ``scenario``, ``parsed`` and ``problem``, and the session swaps them in (a new track
 clears the scene; a new scenario redraws obstacles, start and goal).
+
+A gizmo's drag previews on viser's event loop while the session's ticker moves the same
+obstacles along the scene clock: the previews take the session's lock, as the ticker does, and
+a dragged obstacle keeps moving along its motion from where it is dragged to.
 """
 
 from __future__ import annotations
@@ -28,8 +32,8 @@ __all__ = ["Stage"]
 
 
 class Stage:
-    def __init__(self, client, clock) -> None:
-        self.client, self.scene, self.clock = client, client.scene, clock
+    def __init__(self, client, clock, lock) -> None:
+        self.client, self.scene, self.clock, self.lock = client, client.scene, clock, lock
         self.track: tracks.Track | None = None
         self.scenario: dict = {}
         self.parsed: planner.Scenario | None = None  # self.scenario, validated
@@ -64,13 +68,16 @@ class Stage:
     def preview_obstacle(self, i: int, x: float, y: float, yaw: float) -> None:
         """Obstacle i drawn at pose (x, y, yaw), plus its motion's offset at the scene time,
         while a gizmo drags it."""
-        frame, _, table = self._drawn[i]
-        dx, dy = table_offsets(table, self.clock.t)[0]
-        _move_frame(frame, x + dx, y + dy, yaw)
+        with self.lock:
+            frame, _, table = self._drawn[i]
+            self._drawn[i] = (frame, (x, y, yaw), table)
+            dx, dy = table_offsets(table, self.clock.t)[0]
+            _move_frame(frame, x + dx, y + dy, yaw)
 
     def preview_pose(self, key: str, x: float, y: float, yaw: float) -> None:
         """The start or the goal (``key``) drawn at (x, y, yaw) while a gizmo drags it."""
-        _move_frame(self._poses[key], x, y, yaw)
+        with self.lock:
+            _move_frame(self._poses[key], x, y, yaw)
 
     def scenario_json(self, name: str) -> str:
         """The scenario as planned (a custom track embedded), named ``name``."""

@@ -3,8 +3,15 @@
 Each node owns the edge from its parent (a rewire changes only that edge), drawn as ``SEG``
 straight pieces along the car's curve. Node i lives in chunk i // CHUNK. The tail chunk (where
 new nodes land) is re-sent at UI rate; a full chunk is re-sent only when a rewire touched it, a
-few chunks per slow tick. So the bytes per second depend on the chunk size and the rates, never
-on the size of the tree.
+few per slow tick. So the bytes per second depend on the chunk size and the rates, never on the
+size of the tree.
+
+Level of detail: the browser draws every line piece every frame, and with software WebGL a
+finished tree of 8 400 nodes at ``SEG`` pieces each drew 0.5 frames/s. Only the newest
+``FULL_CHUNKS`` chunks (where the tree grows, and step mode looks) keep their curves; an older
+chunk is re-sent once as one chord per edge, and past ``OLD_EDGES`` old edges only every
+k-th is drawn. So the drawn pieces stay under FULL_CHUNKS·CHUNK·SEG + OLD_EDGES whatever the
+tree's size; the best path and the step overlay are drawn in full on top.
 
 Each edge also keeps its local path in segment form (kinds, signed lengths), so that a click on
 it can be answered with its steering word (`nearest`, `planner.path_word`).
@@ -12,16 +19,28 @@ it can be answered with its steering word (`nearest`, `planner.path_word`).
 
 from __future__ import annotations
 
+import math
 import threading
 
 import numpy as np
 
-__all__ = ["CHUNK", "SEG", "EdgeChunks"]
+__all__ = ["CHUNK", "FULL_CHUNKS", "OLD_EDGES", "SEG", "EdgeChunks", "edge_segments"]
 
 # Straight pieces per edge: the longest edges on the thesis track (1.8 m, turning up to 115°
 # at ρ = 0.9 m) bend under 10° per piece, so edges read as the car's curves.
 SEG = 12
 CHUNK = 96  # nodes per chunk: SEG · CHUNK pieces (28 kB) per message
+FULL_CHUNKS = 4  # the newest chunks drawn with their curves: 4608 pieces
+OLD_EDGES = 24_000  # chords drawn at most for the older edges
+
+
+def edge_segments(pts: np.ndarray, z: float = 0.0) -> np.ndarray:
+    """Edges as points along them, (n, k + 1, 2), as (n·k, 2, 3) line segments at height z:
+    how every tree the studio shows (live, replayed, the simulation's replanner's) is drawn."""
+    seg = np.full((len(pts), pts.shape[1] - 1, 2, 3), z, np.float32)
+    seg[:, :, 0, :2] = pts[:, :-1]
+    seg[:, :, 1, :2] = pts[:, 1:]
+    return seg.reshape(-1, 2, 3)
 
 
 class EdgeChunks:
@@ -30,8 +49,11 @@ class EdgeChunks:
     Written by the planner's thread, read by the UI's; every method takes the lock.
     """
 
-    def __init__(self, seg: int = SEG, chunk: int = CHUNK, capacity: int = 4096) -> None:
-        self.seg, self.chunk = seg, chunk
+    def __init__(self, seg: int = SEG, chunk: int = CHUNK, capacity: int = 4096,
+                 full_chunks: int = FULL_CHUNKS, old_edges: int = OLD_EDGES) -> None:
+        self.seg, self.chunk, self.full_chunks, self.old_edges = (seg, chunk, full_chunks,
+                                                                   old_edges)
+        self._drawn: dict[int, tuple[int, int]] = {}  # chunk: the level it was sent with
         self._pts = np.zeros((capacity, seg + 1, 2), np.float32)
         self._kinds = np.zeros((capacity, 5), np.int8)
         self._lens = np.zeros((capacity, 5))
@@ -108,31 +130,53 @@ class EdgeChunks:
         with self._lock:
             return self._segments(c)
 
-    def _segments(self, c: int) -> np.ndarray:
-        p = self._pts[c * self.chunk:min((c + 1) * self.chunk, self._n)]
-        seg = np.zeros((len(p), self.seg, 2, 3), np.float32)
-        seg[:, :, 0, :2] = p[:, :-1]
-        seg[:, :, 1, :2] = p[:, 1:]
-        return seg.reshape(-1, 2, 3)
+    def level(self, c: int) -> tuple[int, int]:
+        """How chunk c is drawn now: (pieces per edge, every k-th edge)."""
+        old = self._tail_chunk() + 1 - self.full_chunks  # chunks below this are old
+        if c >= old:
+            return self.seg, 1
+        return 1, -(-old * self.chunk // self.old_edges)
 
-    def take_tail(self) -> list[tuple[int, np.ndarray]]:
-        """The chunks new nodes went into since the last call (the tail, and any it filled)."""
+    def _segments(self, c: int) -> np.ndarray:
+        pieces, every = self._drawn[c] = self.level(c)
+        lo = c * self.chunk
+        p = self._pts[lo + (-lo) % every:min(lo + self.chunk, self._n):every]
+        return edge_segments(p[:, np.linspace(0, self.seg, pieces + 1).astype(int)])
+
+    def take_tail(self, limit: float = math.inf) -> list[tuple[int, np.ndarray]]:
+        """The chunks new nodes went into since the last call (the tail, and any it filled),
+        oldest first, as many as ``limit`` pieces hold (at least one): a tree growing faster
+        than that is drawn behind the planner, and catches up."""
         with self._lock:
             if not self._tail_dirty:
                 return []
-            self._tail_dirty = False
-            tail = self._tail_chunk()
-            out = [(c, self._segments(c)) for c in range(self._sent_n // self.chunk, tail + 1)]
-            self._sent_n = self._n
+            first = self._sent_n // self.chunk
+            out = []
+            for c in range(first, self._tail_chunk() + 1):
+                seg = self._segments(c)
+                if out and len(seg) > limit:
+                    break
+                out.append((c, seg))
+                limit -= len(seg)
+            self._sent_n = min(self._n, (out[-1][0] + 1) * self.chunk)
+            self._tail_dirty = self._sent_n < self._n
+            for c in range(first):  # chunks the tree's growth made old, or sparser
+                if self._drawn.get(c) != self.level(c):
+                    self._dirty[c] = None
             return out
 
     def take_rewired(self, limit: int) -> list[tuple[int, np.ndarray]]:
-        """Up to ``limit`` full chunks that rewires changed, oldest first."""
+        """Full chunks to re-send, oldest first: those rewires changed, and those whose level
+        of detail changed. As many as ``limit`` chunks drawn in full weigh, at least one."""
         with self._lock:
-            picked = list(self._dirty)[:limit]
-            for c in picked:
+            out, budget = [], limit * self.chunk * self.seg
+            for c in list(self._dirty):
+                if out and budget < self.chunk * self.level(c)[0]:
+                    break
                 del self._dirty[c]
-            return [(c, self._segments(c)) for c in picked]
+                out.append((c, self._segments(c)))
+                budget -= len(out[-1][1])
+            return out
 
     def pending_rewired(self) -> int:
         with self._lock:

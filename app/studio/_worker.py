@@ -20,7 +20,8 @@ import queue
 import threading
 import time
 from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -29,12 +30,40 @@ from app.studio._extend import StepInfo
 from app.studio._replay import TreeRecord
 from app.studio._tree import SEG, EdgeChunks
 
-__all__ = ["Lane", "Live", "PlannerWorker"]
+__all__ = ["Lane", "Live", "PlannerWorker", "Rewired", "Step"]
 
 BATCH_S = 0.005
 FLASH_S = 0.6
 METRICS_S = 0.5  # metrics are published at most this often while running
 STEP_CAP = 10_000  # iterations one "step until" takes at most
+
+
+class Rewired(NamedTuple):
+    """A node a step rewired: its edge before and after ((SEG + 1, 2) points), and its cost."""
+
+    old: np.ndarray
+    new: np.ndarray
+    was: float
+    now: float
+
+
+@dataclass(frozen=True)
+class Step:
+    """One single iteration as the step overlay and the EXTEND panel show it; made on the
+    planner's thread, read on the UI's."""
+
+    info: StepInfo
+    star: bool  # RRT*: the EXTEND lines on the near set and rewiring apply
+    options: planner.PlanOptions
+    x_rand: np.ndarray  # the sample (x, y, θ)
+    nearest: np.ndarray | None  # x_nearest's pose
+    new: np.ndarray | None  # x_new's pose, when a node was added
+    blocked: tuple[np.ndarray, np.ndarray] | None  # where a blocked Steer ended, its motion
+    parent_edge: np.ndarray | None  # x_new's edge from x_min
+    near: np.ndarray  # the near set's poses
+    radius: float
+    rewired: tuple[Rewired, ...]
+    until: tuple = ()  # how the "step until" search ended (`_extend.until_note`'s arguments)
 
 
 @dataclass
@@ -49,7 +78,7 @@ class Live:
     metrics: dict = field(default_factory=dict)
     metrics_version: int = 0
     cost_over_time: list = field(default_factory=list)  # the planner's (s, cost, iteration)
-    step: dict | None = None
+    step: Step | None = None
     step_version: int = 0
     state: str = "ready"
     error: str | None = None
@@ -72,7 +101,7 @@ class Lane:
         self._result = self._timed_costs = None  # timing optimal: the result shown, and of what
         self._star = options.planner == "rrtstar"
         self._stepping = False
-        self.last_step: dict | None = None  # the last single iteration, not yet shown
+        self.last_step: Step | None = None  # the last single iteration, not yet shown
         self._costs_before = None  # the tree's costs before it: a rewired node's old cost
         self._best = None
         self._clearance = self._clearance_of = None  # the best path's, and of which cost
@@ -94,13 +123,13 @@ class Lane:
 
     def found(self, until: str) -> bool:
         """Whether the last single iteration did ``until`` ("node" or "rewire")."""
-        info = self.last_step and self.last_step["info"]
+        info = self.last_step and self.last_step.info
         return bool(info and (info.new >= 0 if until == "node" else info.n_rewired > 0))
 
     def show_step(self, until: tuple) -> None:
         """Publish the last single iteration with how the "step until" search ended."""
         if self.last_step is not None:
-            self.live.step = dict(self.last_step, until=until)
+            self.live.step = replace(self.last_step, until=until)
             self.live.step_version += 1
 
     def steer_points(self, a, b) -> np.ndarray:
@@ -142,19 +171,17 @@ class Lane:
         pose, cost = tree.poses, tree.costs
         info = StepInfo.from_events(ev, -1, len(rewired))
         blocked = info.nearest >= 0 and info.new < 0
-        self.last_step = {
-            "info": info, "star": self._star, "options": tree.options,
-            "x_rand": ev.sample[-1].copy(),
-            "nearest": pose[info.nearest].copy() if info.nearest >= 0 else None,
-            "new": pose[info.new].copy() if info.new >= 0 else None,
-            "blocked": ((ev.steered[-1].copy(),
-                         tree.steer_points(pose[info.nearest], ev.steered[-1], SEG))
-                        if blocked else None),
-            "parent_edge": (self.live.chunks.get(info.new) if info.new >= 0 else None),
-            "near": pose[ev.near_of(-1)].copy(), "radius": info.radius,
-            "rewired": [(old, new, float(self._costs_before[node]), float(cost[node]))
-                        for old, new, node in rewired],
-        }
+        self.last_step = Step(
+            info, self._star, tree.options, ev.sample[-1].copy(),
+            nearest=pose[info.nearest].copy() if info.nearest >= 0 else None,
+            new=pose[info.new].copy() if info.new >= 0 else None,
+            blocked=((ev.steered[-1].copy(),
+                      tree.steer_points(pose[info.nearest], ev.steered[-1], SEG))
+                     if blocked else None),
+            parent_edge=self.live.chunks.get(info.new) if info.new >= 0 else None,
+            near=pose[ev.near_of(-1)].copy(), radius=info.radius,
+            rewired=tuple(Rewired(old, new, float(self._costs_before[node]), float(cost[node]))
+                          for old, new, node in rewired))
 
     def _note_best(self) -> None:
         tree, live = self.tree, self.live
