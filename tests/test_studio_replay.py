@@ -12,7 +12,7 @@ import pytest
 
 import planner
 from app.studio._replay import TreeRecord
-from app.studio._tree import CHUNK, SEG
+from app.studio._tree import CHUNK, FULL_CHUNKS, OLD_SEG, SEG
 from tests._studio_tab import open_tab, wait
 
 OPTIONS = planner.PlanOptions(planner="rrtstar", seed=3)
@@ -116,9 +116,16 @@ def test_a_lecture_run_is_recorded_whole():
         worker.stop()
 
 
+def _pieces(view, c: int) -> int:
+    """Pieces per edge in chunk c: SEG in the newest FULL_CHUNKS shown, OLD_SEG in the older
+    ones (a tree this small draws every edge)."""
+    last = max(c for c, h in view._chunks.items() if h.visible)
+    return SEG if c >= last + 1 - FULL_CHUNKS else OLD_SEG
+
+
 def _drawn_nodes(view) -> int:
-    """Tree edges in the scene: the visible chunks' pieces, SEG per node."""
-    return sum(len(h.points) for h in view._chunks.values() if h.visible) // SEG
+    """Tree edges in the scene: the visible chunks' pieces over their pieces per edge."""
+    return sum(len(h.points) // _pieces(view, c) for c, h in view._chunks.items() if h.visible)
 
 
 def test_the_slider_redraws_the_tree_of_an_earlier_iteration_and_goes_back_to_the_run():
@@ -142,7 +149,8 @@ def test_the_slider_redraws_the_tree_of_an_earlier_iteration_and_goes_back_to_th
         final = run.worker.record.frame(800).parent
         node = int(np.flatnonzero(frame.parent != final[:frame.nodes])[0])
         poses = run.worker.record.poses(frame.nodes)
-        drawn = view._chunks[node // CHUNK].points[(node % CHUNK) * SEG:][:SEG]
+        per = _pieces(view, node // CHUNK)
+        drawn = view._chunks[node // CHUNK].points[(node % CHUNK) * per:][:per]
         assert drawn[0, 0, :2] == pytest.approx(poses[frame.parent[node], :2], abs=1e-4)
         assert drawn[-1, 1, :2] == pytest.approx(poses[node, :2], abs=1e-4)
         assert f"iteration 200 of 800 · {frame.nodes:,} nodes" in ui.replay_note.content

@@ -16,7 +16,7 @@ from app.studio._edit import moved_obstacle, parse_waypoints
 from app.studio._extend import RRT_LINES, STAR_LINES, StepInfo, explain, render
 from app.studio._panel import STEERINGS
 from app.studio._scenario import default_scenario
-from app.studio._tree import CHUNK, FULL_CHUNKS, OLD_EDGES, SEG, EdgeChunks
+from app.studio._tree import CHUNK, FULL_CHUNKS, OLD_PIECES, OLD_SEG, SEG, EdgeChunks
 from planner.problem import resolve_track
 
 
@@ -109,8 +109,8 @@ def test_chunk_messages_stay_the_same_size_however_big_the_tree():
 
 def test_the_drawn_tree_stays_bounded_however_big_it_grows():
     """What the browser holds, tick after tick, while a tree grows to 30 000 nodes: the newest
-    chunks in full, older edges as chords, and past OLD_EDGES of them every k-th; always under
-    the bound, and every node's chunk is drawn."""
+    chunks in full, older edges in OLD_SEG pieces, and past OLD_PIECES of those every k-th
+    edge (k a power of two); always under the bound, and every node's chunk is drawn."""
     ch = EdgeChunks()
     curve = np.column_stack([np.linspace(0, 1, SEG + 1), np.linspace(0, 1, SEG + 1) ** 2])
     browser: dict[int, np.ndarray] = {}
@@ -122,13 +122,18 @@ def test_the_drawn_tree_stays_bounded_however_big_it_grows():
     while ch.pending_rewired():
         browser.update(ch.take_rewired(4))
     drawn = sum(len(seg) for seg in browser.values())
-    assert drawn <= FULL_CHUNKS * CHUNK * SEG + OLD_EDGES, drawn
+    assert drawn <= FULL_CHUNKS * CHUNK * SEG + OLD_PIECES, drawn
     assert len(browser) == ch.chunks
     newest, oldest = browser[ch.chunks - 1], browser[0]
     assert len(newest) == (30_000 % CHUNK or CHUNK) * SEG  # the tail keeps its curves
-    # The oldest chunk: every second edge (29 000 old nodes > OLD_EDGES), each as its chord.
-    assert np.allclose(oldest[:, 0, :2], curve[0] + np.arange(0, CHUNK, 2)[:, None])
-    assert np.allclose(oldest[:, 1, :2], curve[-1] + np.arange(0, CHUNK, 2)[:, None])
+    old_nodes = (ch.chunks - FULL_CHUNKS) * CHUNK
+    stride = 1 << (math.ceil(old_nodes * OLD_SEG / OLD_PIECES) - 1).bit_length()
+    assert stride > 1
+    edges = np.arange(0, CHUNK, stride)
+    assert len(oldest) == len(edges) * OLD_SEG
+    knots = curve[np.linspace(0, SEG, OLD_SEG + 1).astype(int)]  # along the curve, not a chord
+    assert np.allclose(oldest[:, 0, :2], (knots[:-1] + edges[:, None, None]).reshape(-1, 2))
+    assert np.allclose(oldest[:, 1, :2], (knots[1:] + edges[:, None, None]).reshape(-1, 2))
     assert np.allclose(ch.get(0), curve)  # clicks and replay still see the full edge
 
 

@@ -44,6 +44,7 @@ def launch(host: str, port: int, api_url: str, access: Access | None = None) -> 
     server = viser.ViserServer(host=host, port=port, verbose=False)
     server.gui.configure_theme(control_width="large", show_share_button=False)
     server.scene.world_axes.visible = False
+    server.scene.configure_default_lights(cast_shadow=False)
     handle = StudioHandle(server=server, port=server.get_port())
     gate = Gate(server, access or Access.build(host, [], [], None))
     lock = threading.Lock()

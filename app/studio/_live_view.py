@@ -68,10 +68,11 @@ MARKER_PX = 6.0  # a marker's size in the fitted view: the scale when the camera
 # per update it renders, more than per byte (Chromium with software WebGL drew 1.5 frames/s
 # while a chunk went out every tick, and fell to 1.5 from 20 with ten small chunks a second).
 # A burst holds at most 4 chunks of new nodes (a tree growing faster is drawn behind the
-# planner and catches up), 4 chunks' worth of rewired or re-levelled ones, and the rewire
-# flashes (0.6 s each, the newest 32, every other point of the edge): at most 1.2 MB/s.
+# planner and catches up), 8 rewired or re-levelled chunks (at most FULL_CHUNKS of them in
+# full, the rest a quarter of that or less), and the rewire flashes (0.6 s each, the newest 32,
+# every other point of the edge): at most 1.2 MB/s.
 TAIL_PIECES = 4 * CHUNK * SEG
-REWIRED_PER_TICK = 4
+REWIRED_PER_TICK = 8
 TREE_EVERY = 5  # ticks
 FLASH_STRIDE = 2
 FLASHES_DRAWN = 32

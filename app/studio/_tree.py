@@ -6,12 +6,14 @@ new nodes land) is re-sent at UI rate; a full chunk is re-sent only when a rewir
 few per slow tick. So the bytes per second depend on the chunk size and the rates, never on the
 size of the tree.
 
-Level of detail: the browser draws every line piece every frame, and with software WebGL a
-finished tree of 8 400 nodes at ``SEG`` pieces each drew 0.5 frames/s. Only the newest
-``FULL_CHUNKS`` chunks (where the tree grows, and step mode looks) keep their curves; an older
-chunk is re-sent once as one chord per edge, and past ``OLD_EDGES`` old edges only every
-k-th is drawn. So the drawn pieces stay under FULL_CHUNKS·CHUNK·SEG + OLD_EDGES whatever the
-tree's size; the best path and the step overlay are drawn in full on top.
+Level of detail: the browser redraws every line piece whenever anything in the scene changes,
+and with software WebGL each piece costs ~12 µs a frame (Chromium's SwiftShader: 12 000 pieces
+drew 6.5 frames/s, 48 000 drew 1.5). Only the newest ``FULL_CHUNKS`` chunks (where the tree
+grows, and step mode looks) keep ``SEG`` pieces per edge; an older chunk is re-sent once with
+``OLD_SEG`` pieces per edge (a chord alone would cut across the infield), and past
+``OLD_PIECES`` of those only every k-th edge is drawn. So the drawn pieces stay under
+FULL_CHUNKS·CHUNK·SEG + OLD_PIECES whatever the tree's size; the best path and the step overlay
+are drawn in full on top.
 
 Each edge also keeps its local path in segment form (kinds, signed lengths), so that a click on
 it can be answered with its steering word (`nearest`, `planner.path_word`).
@@ -24,14 +26,15 @@ import threading
 
 import numpy as np
 
-__all__ = ["CHUNK", "FULL_CHUNKS", "OLD_EDGES", "SEG", "EdgeChunks", "edge_segments"]
+__all__ = ["CHUNK", "FULL_CHUNKS", "OLD_PIECES", "OLD_SEG", "SEG", "EdgeChunks", "edge_segments"]
 
 # Straight pieces per edge: the longest edges on the thesis track (1.8 m, turning up to 115°
 # at ρ = 0.9 m) bend under 10° per piece, so edges read as the car's curves.
 SEG = 12
 CHUNK = 96  # nodes per chunk: SEG · CHUNK pieces (28 kB) per message
-FULL_CHUNKS = 4  # the newest chunks drawn with their curves: 4608 pieces
-OLD_EDGES = 24_000  # chords drawn at most for the older edges
+FULL_CHUNKS = 2  # the newest chunks drawn with their curves: 2304 pieces
+OLD_SEG = 3  # pieces per older edge: a 115° turn bends under 40° per piece
+OLD_PIECES = 4_500  # pieces drawn at most for the older edges
 
 
 def edge_segments(pts: np.ndarray, z: float = 0.0) -> np.ndarray:
@@ -50,9 +53,10 @@ class EdgeChunks:
     """
 
     def __init__(self, seg: int = SEG, chunk: int = CHUNK, capacity: int = 4096,
-                 full_chunks: int = FULL_CHUNKS, old_edges: int = OLD_EDGES) -> None:
-        self.seg, self.chunk, self.full_chunks, self.old_edges = (seg, chunk, full_chunks,
-                                                                   old_edges)
+                 full_chunks: int = FULL_CHUNKS, old_seg: int = OLD_SEG,
+                 old_pieces: int = OLD_PIECES) -> None:
+        self.seg, self.chunk, self.full_chunks = seg, chunk, full_chunks
+        self.old_seg, self.old_pieces = min(old_seg, seg), old_pieces
         self._drawn: dict[int, tuple[int, int]] = {}  # chunk: the level it was sent with
         self._pts = np.zeros((capacity, seg + 1, 2), np.float32)
         self._kinds = np.zeros((capacity, 5), np.int8)
@@ -135,7 +139,8 @@ class EdgeChunks:
         old = self._tail_chunk() + 1 - self.full_chunks  # chunks below this are old
         if c >= old:
             return self.seg, 1
-        return 1, -(-old * self.chunk // self.old_edges)
+        need = -(-old * self.chunk * self.old_seg // self.old_pieces)
+        return self.old_seg, 1 << (need - 1).bit_length()  # doubling: rarely re-levelled
 
     def _segments(self, c: int) -> np.ndarray:
         pieces, every = self._drawn[c] = self.level(c)
@@ -166,16 +171,14 @@ class EdgeChunks:
             return out
 
     def take_rewired(self, limit: int) -> list[tuple[int, np.ndarray]]:
-        """Full chunks to re-send, oldest first: those rewires changed, and those whose level
-        of detail changed. As many as ``limit`` chunks drawn in full weigh, at least one."""
+        """Up to ``limit`` full chunks to re-send, oldest first: those rewires changed, and
+        those whose level of detail changed. The browser's cost is per scene node replaced,
+        more than per piece, so the limit counts chunks."""
         with self._lock:
-            out, budget = [], limit * self.chunk * self.seg
-            for c in list(self._dirty):
-                if out and budget < self.chunk * self.level(c)[0]:
-                    break
+            out = []
+            for c in list(self._dirty)[:limit]:
                 del self._dirty[c]
                 out.append((c, self._segments(c)))
-                budget -= len(out[-1][1])
             return out
 
     def pending_rewired(self) -> int:
