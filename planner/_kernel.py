@@ -38,7 +38,7 @@ from planner._steer import (
     steer_path,
     steer_tight_bound,
 )
-from planner._world import World, motion_free, static_clearance_estimate
+from planner._world import World, free_length, motion_free, static_clearance_estimate
 
 # Parameter vector indices.
 (EPS, GAMMA, GOAL_BIAS, RHO, SPEED, GX, GY, GTH, GPOS, GHEAD, INFORMED, STAR, STEERING,
@@ -61,14 +61,22 @@ POLISH_SHARE = 0.2
 # ... beyond a first few thousand evaluations, which the first polishes of a short run may spend
 # whatever the search has spent so far (at the first solution that can be a few dozen).
 POLISH_FREE = 5000
+# A Steer blocked after a free part f (static scenes): x_new moves back to f·KEEP_SHARE, if
+# that is KEEP_MIN·ρ or more (with the steering metric: the SE(2) nearest's path may loop, and
+# its cut nodes left slalom unsolved). The tree reaches along narrow lanes instead of dropping
+# every sample it cannot reach whole (benchmarks/results/scenes.md: first solutions 1.6–2.5×
+# sooner on the stadium lap, the maze and the corridors); nearer the obstacle (0.75) it was
+# slower.
+KEEP_SHARE, KEEP_MIN = 0.5, 1.0
 # What `iterate` returns: the batch ran; the tree is full (grow it and call again); a polish
 # is due (call `polish`, then `iterate` for the rest of the batch); the event buffers might not
 # hold the next iteration's near set and rewires (grow them and call again).
 RAN, FULL, POLISH_DUE, EVENTS_FULL = range(4)
 # Event row columns (only written when the event buffers are non-empty); EV_XN..EV_THN: where
-# Steer ended, x_new whether the motion to it was free or not.
+# Steer ended, whether the motion to it was free or not; EV_FREE: how far a blocked one was free
+# (static scenes; -1: not blocked).
 EV_ITER, EV_XR, EV_YR, EV_THR, EV_NEAREST, EV_NEW, EV_PARENT, EV_NEAR_START, EV_NEAR_END, \
-    EV_RADIUS, EV_BEST, EV_XN, EV_YN, EV_THN, EV_COLS = range(15)
+    EV_RADIUS, EV_BEST, EV_XN, EV_YN, EV_THN, EV_FREE, EV_COLS = range(16)
 
 
 class Tree(NamedTuple):
@@ -710,9 +718,21 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
         tree.cnt[CHECKS] += 1
         parent = near_i
         c_new = tree.cost[near_i] + dist
-        if not motion_free(w, nx0, ny0, nth0, tree.cost[near_i] / P[SPEED], kinds, lens,
-                           P[RHO], P[SPEED], counter):
-            if P[STAR] == 0.0 or not timed:
+        free = free_length(w, nx0, ny0, nth0, tree.cost[near_i] / P[SPEED], kinds, lens,
+                           P[RHO], P[SPEED], counter)
+        if free != math.inf and not timed:
+            if record:
+                ev.rows[row, EV_FREE] = free
+            if P[METRIC] == SE2_METRIC or free * KEEP_SHARE < KEEP_MIN * P[RHO]:
+                continue  # the SE(2) nearest's path may loop: its first half is no advance
+            dist = free * KEEP_SHARE
+            truncate(kinds, lens, dist, cut)
+            lens[:] = cut
+            c_new = tree.cost[near_i] + dist
+            x, y, th = path_end(nx0, ny0, nth0, kinds, lens, P[RHO])
+            th = wrap_angle(th)
+        elif free != math.inf:
+            if P[STAR] == 0.0:
                 continue  # as in Karaman & Frazzoli's EXTEND and OMPL: x_new is dropped
             # With moving obstacles another near node may still reach x_new: one that arrives
             # later, when the way is clear.

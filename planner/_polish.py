@@ -27,6 +27,7 @@ from planner._steer import state, steer_length, steer_path
 from planner._world import World, motion_free
 
 PASSES = 2  # split, descend, prune
+SPLIT_MIN = 0.25  # ρ: the shortest edge a split leaves
 ROUNDS = 6  # step halvings per descent: from a quarter of the mean edge to 1/1000 of it
 # Poses a pruned edge may skip at most: a path fresh from the tree has ~100 poses, and trying
 # every later pose made pruning quadratic, 90 % of a polish's motion checks, for no shorter path.
@@ -80,19 +81,26 @@ def polish_path(w: World, code: int, rho: float, speed: float, poses: np.ndarray
 
 @njit(cache=True)
 def _split(code: int, rho: float, poses: np.ndarray, kinds, lens) -> np.ndarray:
-    """Every edge cut in two at the pose halfway along it (the path itself is unchanged)."""
+    """Every edge of `SPLIT_MIN`·2ρ or more cut in two at the pose halfway along it (the path
+    itself is unchanged). Shorter edges stay whole: a polish that stops at its budget keeps its
+    split poses, and splitting every edge each time grew a corridor's best path to 7 446 poses
+    (5.8 mm apart) and its last polish to 0.3 s."""
     n = poses.shape[0]
     out = np.empty((2 * n - 1, 3))
+    k = 0
     for i in range(n - 1):
         a, b = poses[i], poses[i + 1]
-        half = 0.5 * steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], rho, kinds, lens)
-        x, y, th, _, _ = pose_at(a[0], a[1], a[2], kinds, lens, rho, half)
-        out[2 * i, :] = a
-        out[2 * i + 1, 0] = x
-        out[2 * i + 1, 1] = y
-        out[2 * i + 1, 2] = wrap_angle(th)
-    out[2 * n - 2, :] = poses[n - 1]
-    return out
+        out[k, :] = a
+        k += 1
+        length = steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], rho, kinds, lens)
+        if length >= 2.0 * SPLIT_MIN * rho:
+            x, y, th, _, _ = pose_at(a[0], a[1], a[2], kinds, lens, rho, 0.5 * length)
+            out[k, 0] = x
+            out[k, 1] = y
+            out[k, 2] = wrap_angle(th)
+            k += 1
+    out[k, :] = poses[n - 1]
+    return out[:k + 1].copy()
 
 
 @njit(cache=True)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from planner._world import REACH, World, path_clearances
+from planner._world import REACH, World, least_clearance
 
 __all__ = ["CHECK_M", "CHECK_S", "SPACING_M", "chord_sag", "polyline", "polyline_clearance"]
 
@@ -56,4 +56,4 @@ def polyline(rows: np.ndarray, step: float = CHECK_M, time_step: float = CHECK_S
 def polyline_clearance(world: World, rows: np.ndarray, timed: bool) -> float:
     """The least clearance of the rows' polyline (in space-time when ``timed``)."""
     fine = polyline(rows, reach=float(world.geo[REACH]))
-    return float(path_clearances(world, fine, timed).min())
+    return float(least_clearance(world, fine, timed))

@@ -27,6 +27,7 @@ CONTACT = 1e-4
 # Distance evaluations that filling the clearance grid may take (~1 s): a crowded scene gets
 # coarser cells instead of a compile without end (10 000 circles took 46 s at full size).
 GRID_WORK = 1e8
+FAR_CELLS = 6  # cells farther out in the open hold a lower bound of their clearance
 # Indices into World.geo.
 XMIN, YMIN, XMAX, YMAX, RADIUS, VMAX_OBS, HAS_REGION, REACH = range(8)
 STATIC, VELOCITY, WAYPOINTS = 0, 1, 2
@@ -274,10 +275,56 @@ def _point_static(w: World, x: float, y: float) -> float:
 
 @njit(cache=True)
 def _fill_sdf(w: World) -> None:
-    x0, y0, h = w.sdf_geo[0], w.sdf_geo[1], w.sdf_geo[2]
-    for i in range(w.sdf.shape[0]):
-        for j in range(w.sdf.shape[1]):
-            w.sdf[i, j] = _point_static(w, x0 + (i + 0.5) * h, y0 + (j + 0.5) * h)
+    """The clearance grid, exact where it decides anything, a lower bound elsewhere.
+
+    Point clearance is 1-Lipschitz, so the clearance d at a block's centre bounds every cell
+    of the block from below by d − (its distance from the centre). An 8 × 8 block wholly
+    inside an obstacle gets only that (all a sample test or a motion check needs there is a
+    negative value); so does a 2 × 2 block at least `FAR_CELLS` cells out in the open (within
+    1.5 cells of the truth). Only cells near an edge are measured one by one: the stadium
+    lap's grid took 39 ms exactly and takes a fraction now.
+    """
+    h = w.sdf_geo[2]
+    nx, ny = w.sdf.shape
+    for bi in range(0, nx, 8):
+        for bj in range(0, ny, 8):
+            ie, je = min(bi + 8, nx), min(bj + 8, ny)
+            hi = _bound_block(w, bi, ie, bj, je)[1]
+            if hi < -h:
+                continue
+            for i in range(bi, ie, 2):
+                for j in range(bj, je, 2):
+                    i1, j1 = min(i + 2, ie), min(j + 2, je)
+                    if hi > FAR_CELLS * h:  # else every cell of the block is near an edge
+                        low, high = _bound_block(w, i, i1, j, j1)
+                        if high < -h or low > FAR_CELLS * h:
+                            continue
+                    for a in range(i, i1):
+                        for b in range(j, j1):
+                            x, y = _cell_centre(w, a, b)
+                            w.sdf[a, b] = _point_static(w, x, y)
+
+
+@njit(cache=True, inline="always")
+def _cell_centre(w: World, i: float, j: float):
+    """The centre of cell (i, j); between cells for fractional indices."""
+    h = w.sdf_geo[2]
+    return w.sdf_geo[0] + (i + 0.5) * h, w.sdf_geo[1] + (j + 0.5) * h
+
+
+@njit(cache=True)
+def _bound_block(w: World, i0: int, i1: int, j0: int, j1: int):
+    """Write into cells [i0, i1) × [j0, j1) the lower bound from the clearance at their
+    centre; returns the least and the most clearance any of them can have."""
+    h = w.sdf_geo[2]
+    cx, cy = _cell_centre(w, 0.5 * (i0 + i1 - 1), 0.5 * (j0 + j1 - 1))
+    d = _point_static(w, cx, cy)
+    for i in range(i0, i1):
+        for j in range(j0, j1):
+            x, y = _cell_centre(w, i, j)
+            w.sdf[i, j] = d - math.hypot(x - cx, y - cy)
+    r = 0.5 * h * math.hypot(i1 - i0 - 1, j1 - j0 - 1)
+    return d - r, d + r
 
 
 @njit(cache=True)
@@ -392,9 +439,18 @@ def clearance_bound(w: World, x: float, y: float, c: float, s: float, t: float) 
 def motion_free(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> bool:
     """Exact check of a whole segment path driven from time t0 at ``speed``.
 
-    ``counter`` (int64[1]) accumulates clearance evaluations, for the metrics. Poses along a
-    segment come from its start's cos and sin: two trigonometric calls per step on an arc,
-    none on a straight.
+    ``counter`` (int64[1]) accumulates clearance evaluations, for the metrics.
+    """
+    return free_length(w, x, y, th, t0, kinds, lens, rho, speed, counter) == math.inf
+
+
+@njit(cache=True)
+def free_length(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> float:
+    """How far a segment path driven from time t0 at ``speed`` is certified free: +inf for
+    all of it, else a driven length short of the first contact (every step before it is free).
+
+    Poses along a segment come from its start's cos and sin: two trigonometric calls per step
+    on an arc, none on a straight.
     """
     # A footprint disc at offset a moves at most (1 + a/ρ) times as far as the car drives.
     slow = 1.0 + w.geo[VMAX_OBS] / speed + w.geo[REACH] / rho
@@ -425,13 +481,13 @@ def motion_free(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> boo
             if d == -math.inf:
                 d = clearance_bound(w, px, py, c, sn, t0 + (driven + s) / speed)
             if d <= CONTACT:
-                return False
+                return driven + s
             if s >= length:
                 break
             s = min(length, s + d / slow)
         x, y, th = advance(x, y, th, kinds[i], seg, rho)
         driven += length
-    return True
+    return math.inf
 
 
 @njit(cache=True)
@@ -441,6 +497,32 @@ def path_moving_clearances(w: World, samples: np.ndarray) -> np.ndarray:
     for k in range(samples.shape[0]):
         out[k] = moving_clearance(w, samples[k, 0], samples[k, 1], samples[k, 2], samples[k, 5])
     return out
+
+
+@njit(cache=True)
+def least_clearance(w: World, samples: np.ndarray, timed: bool) -> float:
+    """The least of `path_clearances`, exactly, without measuring every row: clearance is
+    1-Lipschitz in where the footprint's discs are, and they move at most |Δ(x, y)| + reach·|Δθ|
+    between rows, so the rows after one of clearance c, up to c − (least so far) on, cannot be
+    less (a 140 m path through 10 000 circles took 0.4 s measuring every row). With moving
+    obstacles, which move between rows too, every row is measured."""
+    best = math.inf
+    if w.m_kind.shape[0] > 0:
+        for c in path_clearances(w, samples, timed):  # not .min(): numba's array math
+            best = min(best, c)
+        return best
+    slack = 0.0  # how far the footprint may still move before a row could beat the least
+    for k in range(samples.shape[0]):
+        if k > 0:
+            slack -= (math.hypot(samples[k, 0] - samples[k - 1, 0],
+                                 samples[k, 1] - samples[k - 1, 1])
+                      + w.geo[REACH] * abs(samples[k, 2] - samples[k - 1, 2]))
+        if slack > 0.0:
+            continue
+        c = pose_clearance(w, samples[k, 0], samples[k, 1], samples[k, 2], 0.0)
+        best = min(best, c)
+        slack = c - best
+    return best
 
 
 @njit(cache=True)

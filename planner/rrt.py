@@ -426,6 +426,7 @@ def _named(ev: K.Events) -> TreeEvents:
         radius=rows[:, K.EV_RADIUS].copy(), best_cost=rows[:, K.EV_BEST].copy(),
         steered=np.where(rows[:, [K.EV_NEAREST]] >= 0, rows[:, [K.EV_XN, K.EV_YN, K.EV_THN]],
                          np.nan),
+        free=np.where(rows[:, K.EV_FREE] >= 0.0, rows[:, K.EV_FREE], np.nan),
         rewires=[Rewire(*map(int, r)) for r in ev.rewires[:n_rw]],
         polished=ev.polished[:n_polished].copy(),
         _near=ev.near[:n_near].copy(), _near_span=ints([K.EV_NEAR_START, K.EV_NEAR_END]))

@@ -85,6 +85,9 @@ class TreeEvents:
     parent: np.ndarray  # (n,) int: x_new's parent (x_min for RRT*)
     radius: np.ndarray  # (n,): the near radius r(n) (0 for RRT, inf for k-nearest)
     steered: np.ndarray  # (n, 3): where Steer ended, x_new added or blocked (NaN: no Steer)
+    # (n,): how far a blocked Steer was free (NaN: not blocked); where half of it is ρ or more,
+    # x_new is the pose there (`planner._kernel.KEEP_SHARE`)
+    free: np.ndarray
     best_cost: np.ndarray  # (n,): the best cost after the iteration (inf: none yet)
     rewires: list[Rewire]
     polished: np.ndarray  # nodes added as the polished best path (`planner._polish`), in order

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from checker import first_collision
 from conftest import scenario_dict
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import planner
@@ -101,3 +101,31 @@ def test_polyline_clearance_is_the_clearance_of_the_chords_not_of_the_arc():
     fine = polyline(rows, step=0.005)
     assert np.hypot(*np.diff(fine[:, :2], axis=0).T).max() <= 0.005 + 1e-12
     assert fine[-1].tolist() == rows[-1].tolist()
+
+
+@settings(max_examples=25, deadline=None)
+@given(obstacles=st.lists(st.tuples(st.floats(0.5, 9.5), st.floats(0.5, 9.5), st.floats(0.05, 1.0),
+                                    st.booleans()), min_size=1, max_size=12),
+       length=st.floats(0.0, 2.0), walk=st.lists(st.tuples(st.floats(-0.1, 0.1),
+                                                           st.floats(-0.1, 0.1),
+                                                           st.floats(-1.0, 1.0)),
+                                                 min_size=1, max_size=60))
+def test_the_least_clearance_measures_few_rows_and_is_every_rows_least(obstacles, length, walk):
+    """`least_clearance` skips rows by how far the footprint moves (a rectangle's corners move
+    with its heading too): it is exactly the least of measuring every row."""
+    from planner._world import least_clearance, path_clearances
+
+    vehicle = ({"footprint": {"type": "rectangle", "length": length, "width": 0.2}}
+               if length > 0.3 else {"radius": 0.1})
+    scn = {"name": "walk", "bounds": [0, 0, 10, 10], "start": [5, 5, 0], "goal": [9, 9, 0],
+           "vehicle": vehicle, "obstacles": [
+               {"type": "circle", "center": [x, y], "radius": r} if round_ else
+               {"type": "polygon", "points": [[x - r, y - r], [x + r, y - r], [x, y + r]]}
+               for x, y, r, round_ in obstacles]}
+    try:
+        world = planner.compile_problem(planner.parse_scenario(scn)).world
+    except ScenarioError:  # the start or goal inside an obstacle
+        assume(False)
+    rows = np.vstack([[5.0, 5.0, 0.0], np.array(walk)]).cumsum(axis=0)
+    rows = np.column_stack([rows, np.zeros((len(rows), 3))])
+    assert least_clearance(world, rows, False) == path_clearances(world, rows, False).min()

@@ -138,29 +138,37 @@ def test_the_drawn_tree_stays_bounded_however_big_it_grows():
 
 
 def test_extend_explains_what_each_iteration_really_did():
-    """Every iteration of a real RRT* run maps to the line its event record implies."""
-    run = planner.Planner(_problem(), planner.PlanOptions(seed=5))
+    """Every iteration of real RRT* runs maps to the line its event record implies: on the
+    thesis track and on slalom, whose longer steps move x_new back from blocked Steers."""
     seen = set()
-    events = []
-    run.add_listener(events.append)
-    for _ in range(400):
-        before = run.nodes
-        run.step(1)
-        ev = events[-1]
-        info = StepInfo.from_events(ev, -1, len(ev.rewires))
-        line, note = explain(info, star=True)
-        seen.add(line)
-        if info.nearest < 0:
-            assert line == 0 and "SampleFree" in note
-        elif info.new < 0:
-            assert line == 3 and run.nodes == before  # no node added
-        else:
-            assert line == (7 if len(ev.rewires) else 6)
-            assert f"#{info.new}" in note and f"#{info.parent}" in note
-            assert run.snapshot().parent[info.new] == info.parent
-    assert {6, 7} <= seen  # nodes were added, with and without rewires
-    html = render(7, "a <note>")
-    assert html.count("<mark>") == 1 and STAR_LINES[7].split(":")[0] in html
+    for name in ("thesis", "slalom"):
+        run = planner.Planner(_problem(name) if name == "thesis" else planner.compile_problem(
+            planner.load_scenario(name)), planner.PlanOptions(seed=5))
+        events = []
+        run.add_listener(events.append)
+        for _ in range(400):
+            before = run.nodes
+            run.step(1)
+            ev = events[-1]
+            info = StepInfo.from_events(ev, -1, len(ev.rewires))
+            line, note = explain(info, star=True)
+            seen.add(line)
+            if info.nearest < 0:
+                assert line == 0 and "SampleFree" in note
+            elif info.new < 0:
+                assert line == 4 and run.nodes == before  # no node added
+            else:
+                assert line == (8 if len(ev.rewires) else 7)
+                assert f"#{info.new}" in note and f"#{info.parent}" in note
+                assert run.snapshot().parent[info.new] == info.parent
+                if info.blocked:  # moved back to half the free part, on Steer's path
+                    seen.add("cut")
+                    assert f"{info.free / 2:.2f} m" in note
+                    assert info.free / 2 >= run.problem.rho
+                    assert not np.allclose(run.snapshot().pose[info.new], ev.steered[-1])
+    assert {7, 8, "cut"} <= seen  # nodes were added, with and without rewires, moved back
+    html = render(8, "a <note>")
+    assert html.count("<mark>") == 1 and STAR_LINES[8].split(":")[0] in html
     assert "&lt;note&gt;" in html
 
 

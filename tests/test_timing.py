@@ -101,5 +101,5 @@ def test_a_crawl_that_needs_too_many_entries_is_refused_naming_max_speed():
     scn = scenario_dict("slalom")
     scn["vehicle"].update(speed=0.001, max_speed=0.001)  # 0.1 mm apart over 23 m
     with pytest.raises(planner.ScenarioError, match="vehicle.max_speed: 0.001 m/s"):
-        planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=300,
+        planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=1000,
                       timing="optimal")

@@ -19,6 +19,7 @@ _GROW = (
     "x_rand ← SampleFree()",
     "x_nearest ← Nearest(T, x_rand)",
     "x_new ← Steer(x_nearest, x_rand)   ▹ at most ε",
+    "if blocked after f: x_new ← Steer's point at f/2   ▹ if f/2 ≥ ρ",
     "if ObstacleFree(x_nearest, x_new):",
 )
 RRT_LINES = (*_GROW, "    T.add(x_new, parent = x_nearest)", "return T")
@@ -44,12 +45,18 @@ class StepInfo:
     n_near: int
     n_rewired: int
     radius: float
+    free: float = math.nan  # how far a blocked Steer was free (NaN: not blocked)
 
     @classmethod
     def from_events(cls, ev: planner.TreeEvents, i: int, n_rewired: int) -> StepInfo:
         """The batch's i-th iteration."""
         return cls(int(ev.iteration[i]), int(ev.nearest[i]), int(ev.new[i]), int(ev.parent[i]),
-                   len(ev.near_of(i)), n_rewired, float(ev.radius[i]))
+                   len(ev.near_of(i)), n_rewired, float(ev.radius[i]), float(ev.free[i]))
+
+    @property
+    def blocked(self) -> bool:
+        """Steer's motion hit an obstacle (x_new then moved back, or was dropped)."""
+        return self.nearest >= 0 and (self.new < 0 or not math.isnan(self.free))
 
 
 def lines(star: bool) -> tuple[str, ...]:
@@ -62,14 +69,19 @@ def explain(info: StepInfo, star: bool) -> tuple[int, str]:
     if info.nearest < 0:
         return 0, "x_rand fell inside an obstacle: SampleFree rejects it (the iteration counts)."
     if info.new < 0:
-        return 3, f"The path from x_nearest (#{info.nearest}) to x_new is blocked: no node added."
+        short = "" if math.isnan(info.free) else f" after {info.free:.2f} m, too short to keep"
+        return 4, (f"The path from x_nearest (#{info.nearest}) to x_new is blocked{short}: "
+                   "no node added.")
+    cut = ("" if math.isnan(info.free) else f"Steer was blocked after {info.free:.2f} m, so "
+           f"x_new is its point at {info.free / 2:.2f} m. ")
     if not star:
-        return 4, f"x_new (#{info.new}) added with parent x_nearest (#{info.parent})."
+        return 5, f"{cut}x_new (#{info.new}) added with parent x_nearest (#{info.parent})."
     if info.n_rewired:
         most = " (the scene labels those that gained most)" if info.n_rewired > 2 else ""
-        return 7, (f"x_new (#{info.new}) joined via x_min (#{info.parent}); {info.n_rewired} of "
-                   f"{info.n_near} near nodes got cheaper through it and were rewired{most}.")
-    return 6, (f"x_new (#{info.new}) joined via x_min (#{info.parent}), the cheapest of "
+        return 8, (f"{cut}x_new (#{info.new}) joined via x_min (#{info.parent}); "
+                   f"{info.n_rewired} of {info.n_near} near nodes got cheaper through it and "
+                   f"were rewired{most}.")
+    return 7, (f"{cut}x_new (#{info.new}) joined via x_min (#{info.parent}), the cheapest of "
                f"{info.n_near} near nodes (r = {info.radius:.2f} m); none got cheaper.")
 
 

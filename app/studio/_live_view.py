@@ -178,8 +178,8 @@ REWIRE_LABELS = 2  # rewired nodes whose old and new costs a step labels
 
 def step_labels(st: Step, bounds, scale: float = 1.0, m_per_px: float | None = None
                 ) -> list[tuple[str, str, tuple[float, float], str]]:
-    """The step overlay's labels (see `place_labels`): x_rand, x_nearest, x_new (blocked or
-    added) and, for the `REWIRE_LABELS` rewired nodes that got cheapest by most, the cost of
+    """The step overlay's labels (see `place_labels`): x_rand, x_nearest, x_new (blocked, or
+    added: moved back from a blocked Steer's end, that too) and, for the `REWIRE_LABELS` rewired nodes that got cheapest by most, the cost of
     reaching each by the old and the new edge, at the middle of each (in a big tree one
     iteration rewires many: their labels would stack unread; every edge is still drawn)."""
     points = [("step_rand_l", "x_rand", st.x_rand)]
@@ -187,6 +187,8 @@ def step_labels(st: Step, bounds, scale: float = 1.0, m_per_px: float | None = N
         points.append(("step_nearest_l", "x_nearest", st.nearest))
     if st.new is not None:
         points.insert(0, ("step_new_l", "x_new", st.new))
+        if st.blocked is not None:  # moved back from where Steer was blocked
+            points.append(("step_blocked_l", "Steer blocked", st.blocked[0]))
     elif st.blocked is not None:
         points.insert(0, ("step_new_l", "x_new (blocked)", st.blocked[0]))
     most = sorted(st.rewired, key=lambda r: r.now - r.was)[:REWIRE_LABELS]

@@ -170,7 +170,7 @@ class Lane:
         tree = self.tree
         pose, cost = tree.poses, tree.costs
         info = StepInfo.from_events(ev, -1, len(rewired))
-        blocked = info.nearest >= 0 and info.new < 0
+        blocked = info.blocked
         self.last_step = Step(
             info, self._star, tree.options, ev.sample[-1].copy(),
             nearest=pose[info.nearest].copy() if info.nearest >= 0 else None,
