@@ -518,14 +518,15 @@ def chain(parent: np.ndarray, node: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def polish(tree: Tree, w: World, P: np.ndarray, ev) -> None:
+def polish(tree: Tree, w: World, P: np.ndarray, ev, cap: int) -> None:
     """The polish `iterate` stopped for (POLISH_DUE), within what is left of polishing's share
-    of the run's clearance evaluations; the next one is due at twice the iterations."""
+    of the run's clearance evaluations and within ``cap`` of them (what a time budget has left
+    room for); the next one is due at twice the iterations."""
     kinds = np.zeros(5, np.int8)
     lens = np.zeros(5)
     counter = np.zeros(1, np.int64)
     tree.cnt[POLISH_AT] = 2 * tree.cnt[ITER]
-    if _polish_best(tree, w, P, kinds, lens, counter, ev, _polish_allowance(tree)):
+    if _polish_best(tree, w, P, kinds, lens, counter, ev, min(_polish_allowance(tree), cap)):
         _update_best(tree)
     tree.cnt[POLISHED] = int(tree.cost[tree.cnt[BEST]] * 1e6)
     tree.cnt[POLISHED_AT] = tree.cnt[ITER]

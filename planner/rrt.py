@@ -28,6 +28,8 @@ from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points, path_poi
 
 __all__ = ["Planner", "Result", "checked_world", "warm_up"]
 
+NO_CAP = 2**62  # a polish's evaluations outside a time budget: only polishing's share bounds them
+
 
 @dataclass
 class Result:
@@ -119,6 +121,7 @@ class Planner:
         self._clock = _Clock()
         self._compute_time = 0.0
         self._polish_time = 0.0  # of it, polishing the best path
+        self._polish_cap = NO_CAP  # clearance evaluations a polish may spend before a deadline
 
     # -- observation -------------------------------------------------------------------------
     def add_listener(self, listener: Callable[[TreeEvents], None]) -> None:
@@ -222,7 +225,7 @@ class Planner:
                 # Polishing adds at most as many nodes as the tree has room for.
                 events = self._events = _room(events, polished=self._tree.pose.shape[0])
                 started = time.perf_counter()
-                K.polish(self._tree, self._world, self._P, events)
+                K.polish(self._tree, self._world, self._P, events, self._polish_cap)
                 self._polish_time += time.perf_counter() - started
             elif status == K.EVENTS_FULL:
                 events = self._events = _room(events, near=2 * self.nodes)
@@ -273,8 +276,17 @@ class Planner:
             if stop is not None and stop():
                 break
             n = int(min(batch, max_iter - self.iterations))
+            # A polish is counted, not timed (a seed's run is the same on any machine), so in a
+            # time budget it gets the evaluations the run's pace fits into what is left.
+            left = limit - (self._compute_time - start)
+            if math.isfinite(left) and self._compute_time > 0.0:
+                pace = int(self._tree.cnt[K.EVALS]) / self._compute_time
+                self._polish_cap = int(min(pace * left, NO_CAP))
             t0 = time.perf_counter()
-            self.step(n)
+            try:
+                self.step(n)
+            finally:
+                self._polish_cap = NO_CAP
             took = time.perf_counter() - t0
             if self.finished:
                 break

@@ -233,7 +233,7 @@ def test_step_highlights_a_line_of_extend_and_draws_the_iteration(browser, ui_ur
     panel = page.locator("pre", has_text="SampleFree")
     assert panel.locator("mark").count() == 0
     before = canvas_pixels(page)
-    expected = {"SampleFree": "1", "blocked": "4", "joined via": "78"}
+    expected = {"SampleFree": "1", "is blocked": "5", "joined via": "89"}
     for n in range(1, 6):
         click(page, "Step")
         note = page.locator("p", has_text=f"Iteration {n}:")
@@ -249,7 +249,7 @@ def test_step_highlights_a_line_of_extend_and_draws_the_iteration(browser, ui_ur
     # Step tools: single iterations to the first rewire, with r(n) and its numbers; a legend.
     click(page, "Step until a rewire")
     page.locator("p", has_text="until a rewire.").wait_for(timeout=30000)
-    assert panel.locator("mark").inner_text().strip()[0] == "8"  # for x ∈ X_near …: Rewire
+    assert panel.locator("mark").inner_text().strip()[0] == "9"  # for x ∈ X_near …: Rewire
     radius = page.locator("p", has_text="Near radius").inner_text()
     assert re.search(r"r\(n\) = min\(γ·\(log n / n\)\^\(1/d\), ε\) = min\([\d.]+·\(log (\d+) / "
                      r"\1\)\^\(1/3\), [\d.]+\) = min\([\d.]+, [\d.]+\) = [\d.]+ m", radius), radius
