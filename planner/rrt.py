@@ -29,6 +29,7 @@ from planner.tree import Rewire, TreeEvents, TreeSnapshot, edge_points, path_poi
 __all__ = ["Planner", "Result", "checked_world", "warm_up"]
 
 NO_CAP = 2**62  # a polish's evaluations outside a time budget: only polishing's share bounds them
+POLISH_TIME_SHARE = 0.2  # of a time budget's planning, polishing takes at most about this
 
 
 @dataclass
@@ -277,11 +278,11 @@ class Planner:
                 break
             n = int(min(batch, max_iter - self.iterations))
             # A polish is counted, not timed (a seed's run is the same on any machine), so in a
-            # time budget it gets the evaluations the run's pace fits into what is left.
+            # time budget it gets the evaluations its pace fits into what is left, and into
+            # polishing's share of the time.
             left = limit - (self._compute_time - start)
             if math.isfinite(left) and self._compute_time > 0.0:
-                pace = int(self._tree.cnt[K.EVALS]) / self._compute_time
-                self._polish_cap = int(min(pace * left, NO_CAP))
+                self._polish_cap = self._polish_evals_within(left)
             t0 = time.perf_counter()
             try:
                 self.step(n)
@@ -292,6 +293,16 @@ class Planner:
                 break
             # Aim at ~2 ms batches: fine-grained budgets and cost-over-time samples.
             batch = max(1, min(4096, int(batch * (0.002 / took if took > 0 else 2.0))))
+
+    def _polish_evals_within(self, left: float) -> int:
+        """The clearance evaluations a polish may spend in ``left`` seconds and in what is
+        left of polishing's share of the time (`POLISH_TIME_SHARE`), at polishing's pace so far
+        (the run's, before the first polish)."""
+        t, polished = self._tree, self._polish_time
+        done = t.cnt[K.POLISH_EVALS] if polished > 0.0 else t.cnt[K.EVALS]
+        pace = int(done) / (polished if polished > 0.0 else self._compute_time)
+        share = POLISH_TIME_SHARE / (1.0 - POLISH_TIME_SHARE) * (self._compute_time - polished)
+        return int(min(pace * max(min(left, share - polished), 0.0), NO_CAP))
 
     # -- results -----------------------------------------------------------------------------
     def best_path_nodes(self) -> list[int]:
