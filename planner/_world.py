@@ -312,7 +312,7 @@ def _cell_centre(w: World, i: float, j: float):
     return w.sdf_geo[0] + (i + 0.5) * h, w.sdf_geo[1] + (j + 0.5) * h
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _bound_block(w: World, i0: int, i1: int, j0: int, j1: int):
     """Write into cells [i0, i1) × [j0, j1) the lower bound from the clearance at their
     centre; returns the least and the most clearance any of them can have."""
