@@ -34,7 +34,7 @@ SEG = 12
 CHUNK = 96  # nodes per chunk: SEG · CHUNK pieces (28 kB) per message
 FULL_CHUNKS = 2  # the newest chunks drawn with their curves: 2304 pieces
 OLD_SEG = 3  # pieces per older edge: a 115° turn bends under 40° per piece
-OLD_PIECES = 4_500  # pieces drawn at most for the older edges
+OLD_PIECES = 2_000  # pieces drawn at most for the older edges
 
 
 def edge_segments(pts: np.ndarray, z: float = 0.0) -> np.ndarray:
