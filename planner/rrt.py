@@ -278,11 +278,12 @@ class Planner:
                 break
             n = int(min(batch, max_iter - self.iterations))
             # A polish is counted, not timed (a seed's run is the same on any machine), so in a
-            # time budget it gets the evaluations its pace fits into what is left, and into
-            # polishing's share of the time.
+            # time budget it gets the evaluations its pace fits into what is left, and, where
+            # the time is the budget (no iteration count makes the run), into polishing's share
+            # of the time.
             left = limit - (self._compute_time - start)
             if math.isfinite(left) and self._compute_time > 0.0:
-                self._polish_cap = self._polish_evals_within(left)
+                self._polish_cap = self._polish_evals_within(left, timed=iterations is None)
             t0 = time.perf_counter()
             try:
                 self.step(n)
@@ -294,15 +295,18 @@ class Planner:
             # Aim at ~2 ms batches: fine-grained budgets and cost-over-time samples.
             batch = max(1, min(4096, int(batch * (0.002 / took if took > 0 else 2.0))))
 
-    def _polish_evals_within(self, left: float) -> int:
-        """The clearance evaluations a polish may spend in ``left`` seconds and in what is
-        left of polishing's share of the time (`POLISH_TIME_SHARE`), at polishing's pace so far
-        (the run's, before the first polish)."""
+    def _polish_evals_within(self, left: float, timed: bool) -> int:
+        """The clearance evaluations a polish may spend in ``left`` seconds and, if ``timed``,
+        in what is left of polishing's share of the time (`POLISH_TIME_SHARE`), at polishing's
+        pace so far (the run's, before the first polish)."""
         t, polished = self._tree, self._polish_time
         done = t.cnt[K.POLISH_EVALS] if polished > 0.0 else t.cnt[K.EVALS]
         pace = int(done) / (polished if polished > 0.0 else self._compute_time)
-        share = POLISH_TIME_SHARE / (1.0 - POLISH_TIME_SHARE) * (self._compute_time - polished)
-        return int(min(pace * max(min(left, share - polished), 0.0), NO_CAP))
+        if timed:
+            share = POLISH_TIME_SHARE / (1.0 - POLISH_TIME_SHARE) * (self._compute_time
+                                                                     - polished)
+            left = min(left, share - polished)
+        return int(min(pace * max(left, 0.0), NO_CAP))
 
     # -- results -----------------------------------------------------------------------------
     def best_path_nodes(self) -> list[int]:
