@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -333,3 +334,92 @@ def test_along_the_plan_a_car_still_backing_up_brakes_off_it_first():
     assert far.manoeuvre.name == FOLLOW and not far.danger
     near = decide(0.55)
     assert near.manoeuvre.name != FOLLOW or near.danger, near
+
+
+# -- movers that turn at once: their reachable sets ------------------------------------------
+def _walker(t: float, offset, velocity) -> Sensing:
+    return Sensing(t, np.array([offset], float), np.array([velocity], float))
+
+
+def test_the_car_learns_which_movers_turn_at_once():
+    """A walker that reverses between two sensings changes its velocity by more than the
+    uncertainty's accel·Δt + 2·e_v; one that keeps its course, or bends within the bound,
+    does not. The fastest speed seen is kept."""
+    from planner.sim.predict import Agility
+
+    u = Uncertainty(accel=1.0, speed_error=0.1)
+    seen = Agility.none(1)
+    for k, v in enumerate([(1.0, 0.0), (1.0, 0.05), (0.98, 0.2)]):  # within 0.3 m/s per 0.1 s
+        seen.see(_walker(0.1 * k, (0.1 * k, 0.0), v), u)
+    assert not seen.turned[0] and seen.fastest[0] == pytest.approx(math.hypot(1.0, 0.05))
+    seen.see(_walker(0.3, (0.3, 0.0), (-0.6, -0.2)), u)  # turned back at a waypoint
+    assert seen.turned[0]
+
+
+@settings(max_examples=40, deadline=None)
+@given(tau=st.floats(0.0, 5.0), fastest=st.floats(0.0, 2.0), age=st.floats(0.0, 0.2),
+       x=st.floats(-10.0, 10.0), y=st.floats(-10.0, 10.0))
+def test_a_turning_movers_reachable_set_is_a_disc_round_where_it_was_sensed(tau, fastest, age,
+                                                                             x, y):
+    """Grown by (v̂ + e_v)·(age + τ) round the sensed position, whatever its velocity (every
+    place a mover no faster than v̂ can get to, also straight back at the car), held beyond
+    `REACH_S`."""
+    from planner.sim.predict import REACH_S, Agility, reach_world
+
+    world = build_world((-50, -50, 50, 50), 0.0, [(0.0, 0.0, 0.3, 0)], [],
+                        [("velocity", (0.0, 0.0))])
+    sensing = _walker(0.0, (1.0, 0.0), (0.8, 0.0))
+    seen = Agility(np.array([fastest]), np.array([True]))
+    u = Uncertainty()
+    reach = reach_world(world, sensing, age, seen, u)
+    expected = math.hypot(x - 1.0, y) - 0.3 - (fastest + u.speed_error) * min(age + tau,
+                                                                                REACH_S)
+    assert moving_clearance(reach, x, y, 0.0, tau) == pytest.approx(expected, abs=1e-9)
+    assert reach.geo[5] >= fastest + u.speed_error  # VMAX_OBS bounds the set's growth
+    assert reach_world(world, sensing, age, Agility(np.array([fastest]), np.array([False])),
+                       u) is None  # a mover that kept its course keeps its prediction
+
+
+def test_behind_a_walker_that_turns_the_car_keeps_a_distance_it_can_stop_in():
+    """crowd_square variant (walkers' waypoints random, 30 Hz, optimal, seed 0): the car
+    followed a walker 0.7 m behind at 0.9 m/s; the walker turned back at a waypoint and every
+    manoeuvre was already hit within 0.6 s. A walker seen turning before, 0.7 m ahead and
+    walking away: the car follows it as long as it is not known to turn, and brakes (passive
+    safety) when it is; 3 m ahead, it follows either way."""
+    from planner.sim.control import Reference
+    from planner.sim.guard import FOLLOW, guard
+    from planner.sim.predict import Agility, reach_world
+    from planner.sim.vehicle import Limits
+
+    base = build_world((0, 0, 20, 10), 0.2, [(0.0, 0.0, 0.3, 0)], [], [("velocity", (0.0, 0.0))])
+    x = np.arange(0.0, 20.0, 0.05)
+    ref = Reference(np.column_stack([x, np.full_like(x, 5.0), np.zeros((len(x), 2)),
+                                     np.ones(len(x))]))
+    limits = Limits(wheelbase=0.44, max_steer=math.radians(26), max_steer_rate=math.pi,
+                    max_speed=1.5, max_accel=1.0)
+
+    def decide(ahead: float, turned: bool):
+        sensing = _walker(0.0, (5.0 + 0.2 + 0.3 + ahead, 5.0), (0.8, 0.0))
+        seen = Agility(np.array([1.0]), np.array([turned]))
+        return guard(predicted_world(base, sensing, 0.0), 0.0, (5.0, 5.0, 0.0, 0.9, 0.0),
+                     limits, ref, 100, ref.length, 1.0, 0.1, 0.9021, True,
+                     reach=reach_world(base, sensing, 0.0, seen))
+
+    assert decide(0.7, False).manoeuvre.name == FOLLOW
+    near = decide(0.7, True)
+    assert near.manoeuvre.name == "brake" and not near.danger, near
+    assert decide(3.0, True).manoeuvre.name == FOLLOW
+
+
+def test_a_walker_turning_back_ahead_of_the_car_no_longer_hits_it():
+    """The square variant of the test above, run as a user would; it is fair (waiting at the
+    start is free for a minute, against the true motions)."""
+    path = Path(__file__).parent / "data" / "square_walkers_turn.json"
+    scn = json.loads(path.read_text())
+    x, y, th = scn["start"]
+    assert all(pose_valid(scn, x, y, t, th) for t in np.arange(0.0, 60.0, 0.02))
+    run = simulate(planner.load_scenario(path),
+                   SimSettings(rate=30, timing="optimal", seed=0, fixed_latency_ms=20))
+    s = run.summary
+    assert s["collisions"] == 0 and s["reached_goal"], s
+

@@ -96,9 +96,11 @@ class _Rollouts:
 
     def __init__(self, world: World, margin: float, state, limits: Limits,
                  ref: Reference | None, i: int, stop_s: float, rho: float,
-                 done_s: float = math.inf, off: float = 0.0) -> None:
+                 done_s: float = math.inf, off: float = 0.0,
+                 reach: World | None = None) -> None:
         self.world, self.margin, self.limits, self.ref, self.stop_s = (world, margin, limits,
                                                                       ref, stop_s)
+        self.reachable = reach
         self.off = off  # how far the car is from the plan beyond the margin (along the plan)
         likely = world.m_grow.copy()
         likely[:, 1:3] = 0.0  # no growth: each mover where its sensed velocity takes it
@@ -185,8 +187,12 @@ class _Rollouts:
         static = _unsure(path_clearances(self.world, samples, True) + self.margin - off, drive)
         samples[:, 5] = self.t[:n]
         closing = drive + self.closing[:n - 1]
-        bad = np.flatnonzero(_unsure(path_moving_clearances(self.world, samples) - off, closing)
-                             | static)
+        unsure = _unsure(path_moving_clearances(self.world, samples) - off, closing) | static
+        if self.reachable is not None:  # passive safety: at rest before a mover may reach it
+            moving = np.maximum(np.abs(vs[:-1]), np.abs(vs[1:])) > 0.0
+            unsure |= moving & _unsure(path_moving_clearances(self.reachable, samples) - off,
+                                       drive + self.reachable.geo[VMAX_OBS] * STEP)
+        bad = np.flatnonzero(unsure)
         if len(bad) == 0:
             return Outcome(math.inf, True)
         k = bad[0]
@@ -208,7 +214,8 @@ def _toward(v: float, want: float, step: float) -> float:
 
 def guard(world: World, margin: float, state, limits: Limits, ref: Reference | None, i: int,
           stop_s: float, cruise: float, commit: float, rho: float, reverse: bool,
-          stuck: bool = False, done_s: float = math.inf, off: float = 0.0) -> Decision:
+          stuck: bool = False, done_s: float = math.inf, off: float = 0.0,
+          reach: World | None = None) -> Decision:
     """The car's manoeuvre until the next decision, ``commit`` s from now.
 
     ``state``: (x, y, θ, v, δ) now; ``ref``/``i``: the plan and the car's row on it (None: no
@@ -221,9 +228,13 @@ def guard(world: World, margin: float, state, limits: Limits, ref: Reference | N
     a stream of traffic is reached, not stood in, so the check along the plan ends there;
     ``off``: how far the car is from its row on the plan beyond what the margin allows: the
     checks along the plan count it off every clearance (a car that lags outside a tight
-    turn stays outside it), the open-loop manoeuvres start from where the car is.
+    turn stays outside it), the open-loop manoeuvres start from where the car is;
+    ``reach``: the movers' reachable sets (`planner.sim.predict.reach_world`, inflated like
+    ``world``): a commitment along the plan must have the car at rest before one of them
+    reaches it; if only that fails, the car brakes along the plan (a walker may turn into
+    it). The evasive manoeuvres are ranked without them.
     """
-    r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho, done_s, off)
+    r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho, done_s, off, reach)
     tried: list[tuple[Outcome, Manoeuvre]] = []
     if stuck and reverse:  # a forward-only plan finds no way on: make room behind
         m = Manoeuvre(BACK_OFF, -0.5 * cruise, steer=0.0)
@@ -239,12 +250,19 @@ def guard(world: World, margin: float, state, limits: Limits, ref: Reference | N
                 if out.clear_s == math.inf:
                     return Decision(m, out.clear_s, False)
                 tried.append((out, m))
+        if reach is not None:  # clear but for the reachable sets: brake (passive safety)
+            r.reachable = None
+            if r.along(0.0, commit).clear_s == math.inf:
+                return Decision(Manoeuvre("brake", 0.0), math.inf, False)
     else:  # no plan: standing (or braking) where it is, if that is clear
         m = Manoeuvre(STAND, 0.0, steer=state[4])
         out = r.free(m)
         if out.clear_s == math.inf:
             return Decision(m, out.clear_s, False)
         tried.append((out, m))
+    # In danger the likely and grown futures rank the manoeuvres; a reachable set would shut
+    # out every one that moves, backing away from a walker included.
+    r.reachable = None
     s_max = limits.max_steer
     evasive = [Manoeuvre("brake-left", 0.0, steer=s_max),
                Manoeuvre("brake-right", 0.0, steer=-s_max),

@@ -36,11 +36,16 @@ from planner.obstacles import reference_points
 from planner.problem import resolve_track
 from planner.sim.sensing import Sensing
 
-__all__ = ["HORIZON_S", "Lanes", "Uncertainty", "believed_offsets", "predicted_world"]
+__all__ = ["HORIZON_S", "REACH_S", "Agility", "Lanes", "Uncertainty", "believed_offsets",
+           "predicted_world", "reach_world"]
 
 HORIZON_S = 1.0e4  # the predicted straight line is long enough for any run
 LANE_SPACING = 0.05  # m between the centreline samples a lane prediction follows
 LANE_STEP = 0.1  # m of arc between a lane prediction's waypoints (chord error ≤ 2.5 mm at ρ 0.5 m)
+# s over which a reachable set widens, held beyond (`reach_world`). Widening until the car is
+# at rest, the square's walkers left it crawling (16 of 72 runs out of time, 6 at 1 s); at
+# 0.5 s a walker's turn 1 m ahead still hit it (docs/simulation.md).
+REACH_S = 1.0
 LANE_HORIZON_S = 30.0  # s of lane prediction; a mover is believed to stand beyond (re-predicted
 # every cycle, and far beyond any commitment the guard checks)
 
@@ -167,6 +172,59 @@ def predicted_world(base: World, sensing: Sensing, t0: float,
                          m_vel=np.zeros((n, 2)),
                          m_wp_start=np.concatenate([[0], np.cumsum([len(w) for w in wps])]).astype(np.int64),
                          m_wp=np.vstack(wps), m_grow=grow)
+
+
+@dataclass
+class Agility:
+    """What the car has seen each mover (per motion) do: the fastest it went, and whether it
+    ever changed its velocity faster than the `Uncertainty` allows between two sensings — a
+    walker turning at once at a waypoint, a shuttle reversing, a walker setting off."""
+
+    fastest: np.ndarray
+    turned: np.ndarray
+    last: Sensing | None = None
+
+    @classmethod
+    def none(cls, n: int) -> Agility:
+        return cls(np.zeros(n), np.zeros(n, bool))
+
+    def see(self, sensing: Sensing, uncertainty: Uncertainty) -> None:
+        self.fastest = np.maximum(self.fastest, np.hypot(*sensing.velocities.T))
+        if self.last is not None:
+            dt = sensing.t - self.last.t
+            jump = np.hypot(*(sensing.velocities - self.last.velocities).T)
+            self.turned |= jump > uncertainty.accel * dt + 2.0 * uncertainty.speed_error + 1e-9
+        self.last = sensing
+
+
+def reach_world(base: World, sensing: Sensing, t0: float, agility: Agility,
+                uncertainty: Uncertainty = Uncertainty(), known=None,
+                lanes: Lanes | None = None) -> World | None:
+    """The grown prediction (`predicted_world`), but each mover that has turned at once
+    (`Agility`) is where it was sensed, grown by (v̂ + e_v)·τ, τ the time since the sensing
+    (held beyond `REACH_S`) and v̂ the fastest it has been seen to go: its reachable set,
+    whatever it does next, for as long as the car needs to see a turn and act on it.
+
+    A walker that turns at a waypoint has an acceleration no bound covers, but it walks no
+    faster than it does: the guard (passive safety) has the car at rest before one of these
+    sets reaches it. Movers that have kept their course keep the grown prediction: a car
+    that braked for every car behind it in a stream would be run into. None: no mover has
+    turned."""
+    turned = agility.turned & ~(np.zeros(len(agility.turned), bool) if known is None
+                                else np.asarray(known, bool))
+    if not turned.any():
+        return None
+    velocities = np.where(turned[:, None], 0.0, sensing.velocities)
+    world = predicted_world(base, Sensing(sensing.t, sensing.offsets, velocities), t0,
+                            uncertainty, known, lanes)
+    rates = agility.fastest[turned] + uncertainty.speed_error
+    grow = world.m_grow.copy()
+    grow[turned] = np.column_stack([np.zeros_like(rates), rates, np.zeros_like(rates),
+                                    np.full_like(rates, t0 - sensing.t),
+                                    np.full_like(rates, REACH_S)])
+    geo = world.geo.copy()
+    geo[VMAX_OBS] = max(geo[VMAX_OBS], float(rates.max()))
+    return world._replace(geo=geo, m_grow=grow)
 
 
 def _timetable(base: World, m: int, t0: float) -> np.ndarray:

@@ -28,7 +28,7 @@ from planner.sim.fsm.runtime import Behaviour
 from planner.sim.guard import BACK_OFF, FOLLOW, STAND, UNSTICK_S, Decision, guard
 from planner.sim.laps import LapCounter, require_track
 from planner.sim.metrics import AT_REST, MOVING, collision_runs, contacts, cycle_stats
-from planner.sim.predict import Lanes, Uncertainty, predicted_world
+from planner.sim.predict import Agility, Lanes, Uncertainty, predicted_world, reach_world
 from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
 from planner.sim.sensing import Sensing, known_motions, mover_index, sense, true_offsets
@@ -167,11 +167,13 @@ def _state(decision: Decision | None, waiting: bool) -> str:
 def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertainty,
             lanes: Lanes | None, s: SimSettings,
             limits: Limits, state, ref: Reference | None, stop_s: float, cruise: float,
-            commit: float, stuck: bool, done_s: float) -> Decision:
+            commit: float, stuck: bool, done_s: float, agility: Agility) -> Decision:
     """The guard's decision at a cycle's start, in the world the car believes in now (grown
-    predictions, the planning margin; the bare car where it already is inside the margin)."""
-    believed = predicted_world(problem.world, sensing, t, uncertainty,
-                               known_motions(problem.scenario), lanes)
+    predictions, the planning margin; the bare car where it already is inside the margin),
+    the car at rest before a mover that turns at once could reach it (`reach_world`)."""
+    known = known_motions(problem.scenario)
+    believed = predicted_world(problem.world, sensing, t, uncertainty, known, lanes)
+    reach = reach_world(problem.world, sensing, t, agility, uncertainty, known, lanes)
     margin = GUARD_MARGIN * s.margin
     margin = margin if clearance(believed, state[0], state[1], 0.0) > margin else 0.0
     i = ref.project(state[0], state[1])[0] if ref is not None else 0
@@ -179,7 +181,8 @@ def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertain
     if off > OFF_PLAN:
         ref = None  # the car is not where the plan is: checks along it would be fiction
     return guard(inflated(believed, margin), margin, state, limits, ref, i, stop_s, cruise,
-                 commit, problem.rho, s.reverse, stuck, done_s, max(off - margin, 0.0))
+                 commit, problem.rho, s.reverse, stuck, done_s, max(off - margin, 0.0),
+                 inflated(reach, margin) if reach is not None else None)
 
 
 def _lap_counter(scenario: Scenario, problem: Problem, s: SimSettings, load_track):
@@ -240,6 +243,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     v = steer = 0.0
     e_old = math.nan
     sensing, j_sense = None, 0
+    agility = Agility.none(int((movers >= 0).sum()))  # what each mover was seen to do
     ref, stop_s, conflict, done_s = None, 0.0, False, math.inf
     pending, next_cycle = None, 0.0 if fsm is None or fsm.planning else math.inf
     walls, cycles, replans, stops, waits, was_stopped = [], [], 0, 0, 0, False
@@ -259,6 +263,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
             ts = j_sense / s.sense_rate
             if s.replan or sensing is None:  # replanning off: the car knows only t = 0
                 sensing = sense(problem.world, movers, ts, s.sense_rate, s.noise, rng)
+                agility.see(sensing, uncertainty)
             noise = rng.normal(0.0, pose_sigma) if s.noise > 0 else (0.0, 0.0, 0.0)
             est = (x + noise[0], y + noise[1], th + noise[2])
             j_sense += 1
@@ -289,7 +294,8 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                                    (*est, v, steer),
                                    ref, stop_s, cruise, lead,
                                    backing or (not backed_off
-                                               and t - planless_since >= STUCK_S), done_s)
+                                               and t - planless_since >= STUCK_S), done_s,
+                                   agility)
                 decided_at = t
                 if decision.manoeuvre.name == BACK_OFF and not backing:
                     backed_at, backed_off = t, True  # once, until the car drives on again
