@@ -411,6 +411,23 @@ def test_behind_a_walker_that_turns_the_car_keeps_a_distance_it_can_stop_in():
     assert decide(3.0, True).manoeuvre.name == FOLLOW
 
 
+def test_a_stuck_car_backs_off_though_a_turned_mover_stands_near():
+    """back_up: the box backed into the lane and stayed; the car, stuck beside it, did not back
+    off while the box's reachable set (1.5 m round it) shut out every move: 5 of 40 runs
+    missed the goal. Backing off is judged without the reachable sets, as evading is."""
+    from planner.sim.guard import BACK_OFF, guard
+    from planner.sim.predict import Agility, reach_world
+    from planner.sim.vehicle import Limits
+
+    base = build_world((0, 0, 20, 10), 0.2, [(0.0, 0.0, 0.3, 0)], [], [("velocity", (0.0, 0.0))])
+    sensing = _walker(0.0, (6.4, 5.0), (0.0, 0.0))  # 0.9 m ahead of the car, at rest
+    limits = Limits(wheelbase=0.44, max_steer=math.radians(26), max_steer_rate=math.pi,
+                    max_speed=1.5, max_accel=1.0)
+    reach = reach_world(base, sensing, 0.0, Agility(np.array([1.4]), np.array([True])))
+    d = guard(predicted_world(base, sensing, 0.0), 0.0, (5.0, 5.0, 0.0, 0.0, 0.0), limits, None,
+              0, 0.0, 1.0, 0.1, 0.9021, True, stuck=True, reach=reach)
+    assert d.manoeuvre.name == BACK_OFF and not d.danger, d
+
 def test_a_walker_turning_back_ahead_of_the_car_no_longer_hits_it():
     """The square variant of the test above, run as a user would; it is fair (waiting at the
     start is free for a minute, against the true motions)."""

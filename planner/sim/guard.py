@@ -232,15 +232,16 @@ def guard(world: World, margin: float, state, limits: Limits, ref: Reference | N
     ``reach``: the movers' reachable sets (`planner.sim.predict.reach_world`, inflated like
     ``world``): a commitment along the plan must have the car at rest before one of them
     reaches it; if only that fails, the car brakes along the plan (a walker may turn into
-    it). The evasive manoeuvres are ranked without them.
+    it). Backing off when stuck and the evasive manoeuvres are judged without them.
     """
-    r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho, done_s, off, reach)
+    r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho, done_s, off)
     tried: list[tuple[Outcome, Manoeuvre]] = []
     if stuck and reverse:  # a forward-only plan finds no way on: make room behind
         m = Manoeuvre(BACK_OFF, -0.5 * cruise, steer=0.0)
         out = r.free(m)
         if out.clear_s == math.inf:
             return Decision(m, out.clear_s, False)
+    r.reachable = reach
     if ref is not None:
         for share in CAPS:
             m = Manoeuvre(FOLLOW if share == 1.0 else "slow" if share > 0 else "brake",
