@@ -133,6 +133,11 @@ def test_a_lane_prediction_keeps_the_movers_side_and_direction():
     assert np.linalg.norm(ahead - truth, axis=-1)[:, :2].max() < 0.02  # both directions
     world = predicted_world(problem.world, sensing, 1.0, Uncertainty(), lanes=lanes)
     assert world.geo[5] == pytest.approx(0.5 + Uncertainty().rate, abs=0.01)  # VMAX_OBS
+    from planner.sim.predict import Agility, reach_world
+
+    n = len(v)  # movers that keep to their lanes get no reachable set, turned or not
+    assert reach_world(problem.world, sensing, 1.0, Agility(np.ones(n), np.ones(n, bool)),
+                       lanes=lanes) is None
 
 
 def test_along_track_needs_a_track():

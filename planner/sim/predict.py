@@ -208,8 +208,10 @@ def reach_world(base: World, sensing: Sensing, t0: float, agility: Agility,
     A walker that turns at a waypoint has an acceleration no bound covers, but it walks no
     faster than it does: the guard (passive safety) has the car at rest before one of these
     sets reaches it. Movers that have kept their course keep the grown prediction: a car
-    that braked for every car behind it in a stream would be run into. None: no mover has
-    turned."""
+    that braked for every car behind it in a stream would be run into; so are the movers of a
+    scene that says they keep to their lanes (``lanes``). None: no mover has turned."""
+    if lanes is not None:
+        return None
     turned = agility.turned & ~(np.zeros(len(agility.turned), bool) if known is None
                                 else np.asarray(known, bool))
     if not turned.any():
