@@ -140,19 +140,34 @@ def inflated(world: World, margin: float) -> World:
 def without_movers(world: World) -> World:
     """The same world with its moving obstacles left out: where a path may go at all, for a
     planner that then chooses when to drive it (`planner.timing`)."""
-    keep_c = world.circ_motion < 0
-    keep_p = np.flatnonzero(world.poly_motion < 0)
-    counts = np.diff(world.poly_start)[keep_p]
-    edges = [world.poly_edges[world.poly_start[p]:world.poly_start[p + 1]] for p in keep_p]
     geo = world.geo.copy()
     geo[VMAX_OBS] = 0.0
+    return _keep_shapes(world, world.circ_motion < 0, world.poly_motion < 0)._replace(
+        geo=geo, m_kind=np.zeros(0, np.int64), m_vel=np.zeros((0, 2)),
+        m_wp_start=np.zeros(1, np.int64), m_wp=np.zeros((0, 3)), m_grow=np.zeros((0, 5)))
+
+
+def only_movers(world: World, which: np.ndarray) -> World:
+    """The same world with only the shapes of the movers where the boolean ``which`` (per
+    motion) is true: a check against some of them alone (the motion table is kept as it is)."""
+    which = np.asarray(which, bool)
+
+    def moved_by(motion: np.ndarray) -> np.ndarray:
+        return (motion >= 0) & which[np.maximum(motion, 0)] if len(which) else motion < -1
+
+    return _keep_shapes(world, moved_by(world.circ_motion), moved_by(world.poly_motion))
+
+
+def _keep_shapes(world: World, keep_c: np.ndarray, keep_p: np.ndarray) -> World:
+    """``world`` with only the circles and polygons where ``keep_c`` / ``keep_p`` is true."""
+    keep_p = np.flatnonzero(keep_p)
+    counts = np.diff(world.poly_start)[keep_p]
+    edges = [world.poly_edges[world.poly_start[p]:world.poly_start[p + 1]] for p in keep_p]
     return world._replace(
-        geo=geo, circ=world.circ[keep_c], circ_motion=world.circ_motion[keep_c],
+        circ=world.circ[keep_c], circ_motion=world.circ_motion[keep_c],
         poly_edges=np.vstack(edges) if edges else np.zeros((0, 4)),
         poly_start=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
-        poly_bbox=world.poly_bbox[keep_p], poly_motion=world.poly_motion[keep_p],
-        m_kind=np.zeros(0, np.int64), m_vel=np.zeros((0, 2)), m_wp_start=np.zeros(1, np.int64),
-        m_wp=np.zeros((0, 3)), m_grow=np.zeros((0, 5)))
+        poly_bbox=world.poly_bbox[keep_p], poly_motion=world.poly_motion[keep_p])
 
 
 @njit(cache=True)

@@ -368,21 +368,21 @@ def test_a_turning_movers_reachable_set_is_a_disc_round_where_it_was_sensed(tau,
                                                                              x, y):
     """Grown by (v̂ + e_v)·(age + τ) round the sensed position, whatever its velocity (every
     place a mover no faster than v̂ can get to, also straight back at the car), held beyond
-    `REACH_S`."""
+    `REACH_S`. A mover that kept its course has no reachable set, even standing at (x, y)."""
     from planner.sim.predict import REACH_S, Agility, reach_world
 
-    world = build_world((-50, -50, 50, 50), 0.0, [(0.0, 0.0, 0.3, 0)], [],
-                        [("velocity", (0.0, 0.0))])
-    sensing = _walker(0.0, (1.0, 0.0), (0.8, 0.0))
-    seen = Agility(np.array([fastest]), np.array([True]))
+    world = build_world((-50, -50, 50, 50), 0.0, [(0.0, 0.0, 0.3, 0), (0.0, 0.0, 0.3, 1)], [],
+                        [("velocity", (0.0, 0.0))] * 2)
+    sensing = Sensing(0.0, np.array([(1.0, 0.0), (x, y)]), np.array([(0.8, 0.0), (0.0, 0.0)]))
+    seen = Agility(np.array([fastest, 1.0]), np.array([True, False]))
     u = Uncertainty()
     reach = reach_world(world, sensing, age, seen, u)
     expected = math.hypot(x - 1.0, y) - 0.3 - (fastest + u.speed_error) * min(age + tau,
                                                                                 REACH_S)
     assert moving_clearance(reach, x, y, 0.0, tau) == pytest.approx(expected, abs=1e-9)
     assert reach.geo[5] >= fastest + u.speed_error  # VMAX_OBS bounds the set's growth
-    assert reach_world(world, sensing, age, Agility(np.array([fastest]), np.array([False])),
-                       u) is None  # a mover that kept its course keeps its prediction
+    assert reach_world(world, sensing, age, Agility(np.array([fastest, 1.0]), np.zeros(2, bool)),
+                       u) is None  # movers that kept their course keep their prediction
 
 
 def test_behind_a_walker_that_turns_the_car_keeps_a_distance_it_can_stop_in():

@@ -15,6 +15,7 @@ import planner
 from app.studio._clock import SceneClock
 from app.studio._scene import yaw_wxyz
 from app.studio._sim_view import EDGE_PIECES, PREDICT_S, SimView
+from planner.sim.predict import REACH_S
 from planner.sim.sensing import mover_index, true_offsets
 
 
@@ -113,3 +114,29 @@ def test_movers_that_keep_to_the_track_are_drawn_predicted_along_it(view):
     assert np.linalg.norm(ahead - truth, axis=1).max() < 0.05
     turned = np.diff(np.unwrap(np.arctan2(*np.diff(ahead, axis=0).T[::-1])))
     assert abs(turned.sum()) > 0.5  # it bends with the track (radians over the 2 s drawn)
+
+
+def test_a_mover_seen_turning_at_once_gets_its_reachable_set_drawn(view):
+    """The crossing's disc walks 0.8 m/s into the lane and turns back at once at t = 1 s: from
+    then on its reachable set is drawn, an outline round where it was last sensed, its radius
+    the disc's plus (fastest speed seen + e_v)·REACH_S."""
+    crossing = scenario_dict("crossing")
+    crossing["obstacles"][0]["motion"] = {"waypoints": [[-1, 0, -0.8], [1, 0, 0.8], [3, 0, -0.8]]}
+    problem = planner.compile_problem(planner.parse_scenario(crossing))
+    settings = dataclasses.replace(view.settings(), realtime=False, duration=0.8)
+    view.start(problem, settings)
+    while view.run.running:
+        time.sleep(0.05)
+    view.tick()
+    assert not view._handles.get("reachable") or not view._handles["reachable"].visible
+    view.start(problem, dataclasses.replace(settings, duration=2.0))
+    while view.run.running:
+        time.sleep(0.05)
+    view.tick()
+    f = view._shown["frame"]
+    rate = f.reach[0]
+    assert rate == pytest.approx(0.8 + settings.uncertainty(problem.scenario).speed_error)
+    ring = view._handles["reachable"].points[:, 0, :2]
+    sensed = np.array([10.0, -1.3]) + f.sensing.offsets[0]
+    assert np.linalg.norm(ring - sensed, axis=1) == pytest.approx(
+        np.full(len(ring), 1.0 + rate * REACH_S), abs=0.01)

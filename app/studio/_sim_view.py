@@ -9,7 +9,9 @@ believes they are (translucent ghosts: the last sensing carried on as the run pr
 constant velocity or along the track's lanes, with a line along where it predicts them over the
 next ``PREDICT_S``) and their grown predictions (issue 30:
 the shape grown by the run's uncertainty at look-aheads ``LOOK_AHEAD_S``, fading with τ; none
-for a mover whose timetable the car is told, `motion.known`); the
+for a mover whose timetable the car is told, `motion.known`); the reachable set of each mover the
+car has seen turn at once (an orange outline round where it was sensed: the space the car must
+be at rest before entering, `planner.sim.predict.reach_world`); the
 committed path, the tree, Soll/Ist steering and lateral error plots, a safety timeline (speed,
 what the guard has the car do, contacts) and the metrics. The scene marks where the car braked,
 waited, evaded or backed off, and each collision with whose it was.
@@ -42,7 +44,7 @@ from app.studio._scene import (
 from app.studio._tree import edge_segments
 from planner.obstacles import outline
 from planner.sim import SimSettings
-from planner.sim.predict import Lanes, believed_offsets
+from planner.sim.predict import REACH_S, Lanes, believed_offsets
 from planner.sim.run import GUARD_CODES, Frame, simulate
 from planner.sim.sensing import known_motions, mover_index
 from planner.validation import describe
@@ -65,6 +67,7 @@ EVENT_RGB = {"collision": (230, 30, 30), "stall": (240, 170, 0), "brake": (255, 
              "wait": (60, 160, 255), "evade": (200, 40, 200), "back-off": (120, 90, 200)}
 LOOK_AHEAD_S = (0.5, 1.0, 1.5)  # s: grown predictions drawn, fading with the look-ahead
 GROWN_OPACITY = (0.22, 0.14, 0.08)
+REACH_RGB = (250, 110, 30)
 
 
 class _Stopped(Exception):
@@ -179,6 +182,8 @@ class SimView:
         self._handles: dict[str, object] = {}
         self._movers = np.zeros(0, np.int64)  # per scenario obstacle: its motion (-1: static)
         self._centres: dict[int, np.ndarray] = {}  # per mover: its declared centre (m)
+        self._shapes: dict[int, shapely.Polygon] = {}  # per mover: its outline there, in m
+        self._reach_rings: dict[tuple[int, float], np.ndarray] = {}  # (mover, m) → ring
         self._shown = {"frame": None, "reference": None, "path_at": 0.0, "tree": 0, "slow": 0.0,
                        "events": 0}
 
@@ -226,11 +231,15 @@ class SimView:
         self._movers = mover_index(scn)
         known = known_motions(scn)  # the car is told these: no belief of its own to draw
         self._centres.clear()
+        self._shapes.clear()
+        self._reach_rings.clear()
         for i, ob in enumerate(scn.obstacles):
             if self._movers[i] < 0 or known[self._movers[i]]:
                 continue
             (x, y, yaw), local = outline(ob)  # offsets move the declared pose
             self._centres[i] = np.array([x, y])
+            c, sn = math.cos(yaw), math.sin(yaw)
+            self._shapes[i] = shapely.Polygon(local @ np.array([[c, sn], [-sn, c]]))
             self._handles[f"ghost{i}"] = scene.add_frame(
                 f"/sim/ghost{i}", show_axes=False, position=(x, y, 0.0), wxyz=yaw_wxyz(yaw))
             _fill(scene, f"/sim/ghost{i}/shape", [local], GHOST_Z, GHOST_RGB,
@@ -304,12 +313,30 @@ class SimView:
         if lines:
             seg[:, :, :2], seg[:, :, 2] = lines, GHOST_Z
         self._put("prediction", seg, GHOST_RGB, 2.0)
+        self._put("reachable", self._reachable(f), REACH_RGB, 2.0)
         now = time.monotonic()
         if (f.reference is not None and f.reference is not self._shown["reference"]
                 and now - self._shown["path_at"] > PATH_S):
             self._shown["reference"], self._shown["path_at"] = f.reference, now
             self._put("committed", polyline_segments(f.reference.rows[:, :2], Z["path"]),
                       PATH_RGB, 4.0)
+
+    def _reachable(self, f: Frame) -> np.ndarray:
+        """The outline of each reachable set, held at its `REACH_S` extent, round where its
+        mover was sensed (one buffering per mover and cm of growth)."""
+        rings = []
+        if f.sensing is not None and f.reach is not None:
+            for i, c in self._centres.items():
+                m = self._movers[i]
+                if not math.isfinite(f.reach[m]):
+                    continue
+                key = (i, round(float(f.reach[m]) * REACH_S, 2))
+                if key not in self._reach_rings:
+                    grown = self._shapes[i].buffer(key[1], quad_segs=8)
+                    self._reach_rings[key] = np.asarray(grown.exterior.coords)
+                rings.append(polyline_segments(self._reach_rings[key] + c + f.sensing.offsets[m],
+                                               GHOST_Z))
+        return np.concatenate(rings) if rings else np.zeros((0, 2, 3), np.float32)
 
     def _plots(self, run: _Run) -> None:
         h = run.history[:]

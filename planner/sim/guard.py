@@ -96,11 +96,10 @@ class _Rollouts:
 
     def __init__(self, world: World, margin: float, state, limits: Limits,
                  ref: Reference | None, i: int, stop_s: float, rho: float,
-                 done_s: float = math.inf, off: float = 0.0,
-                 reach: World | None = None) -> None:
+                 done_s: float = math.inf, off: float = 0.0) -> None:
         self.world, self.margin, self.limits, self.ref, self.stop_s = (world, margin, limits,
                                                                       ref, stop_s)
-        self.reachable = reach
+        self.reachable: World | None = None  # reachable sets the car must be at rest before
         self.off = off  # how far the car is from the plan beyond the margin (along the plan)
         likely = world.m_grow.copy()
         likely[:, 1:3] = 0.0  # no growth: each mover where its sensed velocity takes it
@@ -262,7 +261,9 @@ def guard(world: World, margin: float, state, limits: Limits, ref: Reference | N
             return Decision(m, out.clear_s, False)
         tried.append((out, m))
     # In danger the likely and grown futures rank the manoeuvres; a reachable set would shut
-    # out every one that moves, backing away from a walker included.
+    # out every one that moves, backing away from a walker included. The options along the
+    # plan tried above keep their outcomes with the sets: where a walker may turn into the
+    # plan, a swerve clear of its likely future is preferred to driving on along it.
     r.reachable = None
     s_max = limits.max_steer
     evasive = [Manoeuvre("brake-left", 0.0, steer=s_max),

@@ -31,13 +31,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._world import VELOCITY, VMAX_OBS, WAYPOINTS, World
+from planner._world import VELOCITY, VMAX_OBS, WAYPOINTS, World, only_movers
 from planner.obstacles import reference_points
 from planner.problem import resolve_track
 from planner.sim.sensing import Sensing
 
 __all__ = ["HORIZON_S", "REACH_S", "Agility", "Lanes", "Uncertainty", "believed_offsets",
-           "predicted_world", "reach_world"]
+           "predicted_world", "reach_rates", "reach_world"]
 
 HORIZON_S = 1.0e4  # the predicted straight line is long enough for any run
 LANE_SPACING = 0.05  # m between the centreline samples a lane prediction follows
@@ -182,7 +182,8 @@ class Agility:
 
     fastest: np.ndarray
     turned: np.ndarray
-    last: Sensing | None = None
+    last_t: float = math.nan  # the previous sensing's time and velocities
+    last_velocities: np.ndarray | None = None
 
     @classmethod
     def none(cls, n: int) -> Agility:
@@ -190,42 +191,50 @@ class Agility:
 
     def see(self, sensing: Sensing, uncertainty: Uncertainty) -> None:
         self.fastest = np.maximum(self.fastest, np.hypot(*sensing.velocities.T))
-        if self.last is not None:
-            dt = sensing.t - self.last.t
-            jump = np.hypot(*(sensing.velocities - self.last.velocities).T)
-            self.turned |= jump > uncertainty.accel * dt + 2.0 * uncertainty.speed_error + 1e-9
-        self.last = sensing
+        if self.last_velocities is not None:
+            jump = np.hypot(*(sensing.velocities - self.last_velocities).T)
+            allowed = uncertainty.accel * (sensing.t - self.last_t) + 2.0 * uncertainty.speed_error
+            self.turned |= jump > allowed + 1e-9
+        self.last_t, self.last_velocities = sensing.t, sensing.velocities
+
+
+def reach_rates(agility: Agility, uncertainty: Uncertainty = Uncertainty(), known=None,
+                lanes: Lanes | None = None) -> np.ndarray:
+    """Per motion: how fast its reachable set (`reach_world`) widens, v̂ + e_v (m/s), v̂ the
+    fastest it has been seen to go; NaN for a mover that has none.
+
+    Only a mover that has turned at once (`Agility`) has one. Movers that have kept their
+    course have only the grown prediction (`predicted_world`): a car that braked for every
+    car behind it in a stream would be run into; so do the movers of a scene that says they
+    keep to their lanes (``lanes``) and those whose timetable the car is told (``known``)."""
+    known = np.zeros(len(agility.turned), bool) if known is None else np.asarray(known, bool)
+    has = agility.turned & ~known & (lanes is None)
+    return np.where(has, agility.fastest + uncertainty.speed_error, math.nan)
 
 
 def reach_world(base: World, sensing: Sensing, t0: float, agility: Agility,
                 uncertainty: Uncertainty = Uncertainty(), known=None,
                 lanes: Lanes | None = None) -> World | None:
-    """The grown prediction (`predicted_world`), but each mover that has turned at once
-    (`Agility`) is where it was sensed, grown by (v̂ + e_v)·τ, τ the time since the sensing
-    (held beyond `REACH_S`) and v̂ the fastest it has been seen to go: its reachable set,
-    whatever it does next, for as long as the car needs to see a turn and act on it.
+    """The movers' reachable sets (`reach_rates`), and no other shape: each mover that has
+    turned at once where it was sensed, grown by (v̂ + e_v)·τ, τ the time since the sensing
+    (held beyond `REACH_S`) — every place it can be, whatever it does next, for as long as the
+    car needs to see a turn and act on it. None: no mover has one.
 
     A walker that turns at a waypoint has an acceleration no bound covers, but it walks no
     faster than it does: the guard (passive safety) has the car at rest before one of these
-    sets reaches it. Movers that have kept their course keep the grown prediction: a car
-    that braked for every car behind it in a stream would be run into; so are the movers of a
-    scene that says they keep to their lanes (``lanes``). None: no mover has turned."""
-    if lanes is not None:
+    sets reaches it."""
+    rates = reach_rates(agility, uncertainty, known, lanes)
+    has = np.isfinite(rates)
+    if not has.any():
         return None
-    turned = agility.turned & ~(np.zeros(len(agility.turned), bool) if known is None
-                                else np.asarray(known, bool))
-    if not turned.any():
-        return None
-    velocities = np.where(turned[:, None], 0.0, sensing.velocities)
-    world = predicted_world(base, Sensing(sensing.t, sensing.offsets, velocities), t0,
-                            uncertainty, known, lanes)
-    rates = agility.fastest[turned] + uncertainty.speed_error
+    velocities = np.where(has[:, None], 0.0, sensing.velocities)
+    world = only_movers(predicted_world(base, Sensing(sensing.t, sensing.offsets, velocities),
+                                        t0, uncertainty, known), has)
     grow = world.m_grow.copy()
-    grow[turned] = np.column_stack([np.zeros_like(rates), rates, np.zeros_like(rates),
-                                    np.full_like(rates, t0 - sensing.t),
-                                    np.full_like(rates, REACH_S)])
+    grow[has] = np.column_stack([np.zeros(has.sum()), rates[has], np.zeros(has.sum()),
+                                 np.full(has.sum(), t0 - sensing.t), np.full(has.sum(), REACH_S)])
     geo = world.geo.copy()
-    geo[VMAX_OBS] = max(geo[VMAX_OBS], float(rates.max()))
+    geo[VMAX_OBS] = float(rates[has].max())
     return world._replace(geo=geo, m_grow=grow)
 
 

@@ -28,7 +28,14 @@ from planner.sim.fsm.runtime import Behaviour
 from planner.sim.guard import BACK_OFF, FOLLOW, STAND, UNSTICK_S, Decision, guard
 from planner.sim.laps import LapCounter, require_track
 from planner.sim.metrics import AT_REST, MOVING, collision_runs, contacts, cycle_stats
-from planner.sim.predict import Agility, Lanes, Uncertainty, predicted_world, reach_world
+from planner.sim.predict import (
+    Agility,
+    Lanes,
+    Uncertainty,
+    predicted_world,
+    reach_rates,
+    reach_world,
+)
 from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
 from planner.sim.sensing import Sensing, known_motions, mover_index, sense, true_offsets
@@ -134,6 +141,9 @@ class Frame:
     replans: int
     cycle_ms: float  # wall time of the latest cycle (NaN before the first)
     guard: str = "follow"  # what the guard has the car do: a key of `GUARD_CODES`
+    # Per motion: how fast its reachable set round ``sensing`` widens (m/s; NaN: none), the
+    # set held at this times `REACH_S` (`planner.sim.predict.reach_rates`).
+    reach: np.ndarray | None = None
 
 
 def _goal_arc(problem: Problem, ref: Reference) -> float:
@@ -244,6 +254,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     e_old = math.nan
     sensing, j_sense = None, 0
     agility = Agility.none(int((movers >= 0).sum()))  # what each mover was seen to do
+    known = known_motions(scenario)
     ref, stop_s, conflict, done_s = None, 0.0, False, math.inf
     pending, next_cycle = None, 0.0 if fsm is None or fsm.planning else math.inf
     walls, cycles, replans, stops, waits, was_stopped = [], [], 0, 0, 0, False
@@ -356,7 +367,8 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
             observer(Frame(t, (x, y, th), v_cmd, steer_cmd, want_steer, e,
                            true_offsets(problem.world, movers, t)[0], sensing, ref,
                            tree, len(cycles), int(replans),
-                           cycles[-1]["ms"] if cycles else math.nan, state))
+                           cycles[-1]["ms"] if cycles else math.nan, state,
+                           reach_rates(agility, uncertainty, known, lanes)))
         v, steer = v_cmd, steer_cmd
         if counter is not None:
             counter.update(t, x, y)
