@@ -64,21 +64,16 @@ class Outcome(NamedTuple):
     clear_s: float
     at_rest: bool
     likely_s: float = math.inf
-    room: float = math.inf  # m: how near a clear rollout comes to the likely futures, walls
 
     @property
     def rank(self):
         """Clear of the grown predictions throughout first, then clear of the likely futures
-        throughout, then at rest when hit, then clear for longest, then the most room.
+        throughout, then at rest when hit, then clear for longest.
 
         Standing still is no refuge from a mover that walks straight at the car: a swerve that
-        leaves its likely path beats a stop in it. Among manoeuvres clear throughout, the one
-        that keeps farthest from the movers' likely paths and the walls: backing away from an
-        oncoming mover along its lane is clear for the horizon too, but ends at the road's end
-        in its way (crowd_overtake with speeds × 0.8: hit at rest), while backing aside
-        leaves its lane."""
+        leaves its likely path beats a stop in it."""
         return (self.clear_s == math.inf, self.likely_s == math.inf, self.at_rest,
-                self.likely_s, self.clear_s, self.room)
+                self.likely_s, self.clear_s)
 
 
 @dataclass(frozen=True)
@@ -150,10 +145,9 @@ class _Rollouts:
         end = int(np.searchsorted(ss, self.done_s)) + 1  # the run ends in the goal
         return self._clear(poses[:end], vs[:end], off[:end])
 
-    def free(self, m: Manoeuvre, room: bool = False) -> Outcome:
+    def free(self, m: Manoeuvre) -> Outcome:
         """Clear time of an open-loop manoeuvre: steering towards ``m.steer`` at the rate
-        limit, speed towards ``m.speed`` for ``m.hold`` s, then braking (``room``: see
-        `_clear`)."""
+        limit, speed towards ``m.speed`` for ``m.hold`` s, then braking."""
         lim = self.limits
         vs = np.empty(self.n)
         steers = np.clip(m.steer, self.steer - lim.max_steer_rate * self.t,
@@ -162,7 +156,7 @@ class _Rollouts:
         for k in range(self.n):
             vs[k] = v
             v = _toward(v, m.speed if k * STEP < m.hold else 0.0, lim.max_accel * STEP)
-        return self._clear(self._poses(vs, steers), vs, room=room)
+        return self._clear(self._poses(vs, steers), vs)
 
     def _poses(self, vs: np.ndarray, steers: np.ndarray) -> np.ndarray:
         """The car's poses from where it is, at these speeds and steering angles per sample:
@@ -178,20 +172,18 @@ class _Rollouts:
         poses[:, 2] = th
         return poses
 
-    def _clear(self, poses: np.ndarray, vs: np.ndarray, off=0.0, room: bool = False) -> Outcome:
+    def _clear(self, poses: np.ndarray, vs: np.ndarray, off=0.0) -> Outcome:
         """The time of the first sample pair that may hide a contact (inf: none): with the
         movers as believed (grown, with the margin), with the static world as it is; if there
         is one, also with the movers' likely futures. ``off`` (m, or per sample): the car may be
         this far from the poses (it is off the plan it tracks), so every clearance counts that
-        much less. ``room``: for a clear rollout, also measure how near it comes to the likely
-        futures and the walls (`Outcome.room`)."""
+        much less."""
         n = len(poses)
         samples = np.zeros((n, 6))
         samples[:, :3] = poses
         drive = np.abs(vs[:-1]) * self.reach * STEP
         samples[:, 5] = math.nan  # static obstacles only
-        walls = path_clearances(self.world, samples, True) + self.margin - off
-        static = _unsure(walls, drive)
+        static = _unsure(path_clearances(self.world, samples, True) + self.margin - off, drive)
         samples[:, 5] = self.t[:n]
         closing = drive + self.closing[:n - 1]
         unsure = _unsure(path_moving_clearances(self.world, samples) - off, closing) | static
@@ -201,10 +193,7 @@ class _Rollouts:
                                        drive + self.reachable.geo[VMAX_OBS] * STEP)
         bad = np.flatnonzero(unsure)
         if len(bad) == 0:
-            if not room:
-                return Outcome(math.inf, True)
-            least = np.minimum(path_moving_clearances(self.likely, samples) - off, walls)
-            return Outcome(math.inf, True, room=float(least.min()))
+            return Outcome(math.inf, True)
         k = bad[0]
         likely = np.flatnonzero(_unsure(path_moving_clearances(self.likely, samples) - off,
                                         closing) | static)
@@ -287,6 +276,6 @@ def guard(world: World, margin: float, state, limits: Limits, ref: Reference | N
                     Manoeuvre("back-up-left", -cruise, EVADE_S, s_max),
                     Manoeuvre("back-up-right", -cruise, EVADE_S, -s_max)]
     for m in evasive:
-        tried.append((r.free(m, room=True), m))
+        tried.append((r.free(m), m))
     out, m = max(tried, key=lambda om: om[0].rank)  # the first of the best
     return Decision(m, out.clear_s, True)
