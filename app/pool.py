@@ -48,13 +48,24 @@ def start_pool(workers: int) -> ProcessPoolExecutor:
 
 
 def stop_pool(pool: ProcessPoolExecutor) -> None:
-    """Stop now: queued tasks are cancelled and running ones terminated with their workers."""
+    """Stop now: queued tasks are cancelled and running ones terminated with their workers.
+
+    A worker terminated while it writes a result leaves half a message in the result pipe, and
+    the pool's manager thread waits for the rest for ever; the interpreter joins that thread at
+    exit, so a server hung on SIGTERM. Closing our own end of the pipe once the workers are
+    gone ends that wait (end of file: the pool counts as broken, which it is)."""
     processes = list(pool._processes.values())  # no public way to stop a running plan
+    results = pool._result_queue
     pool.shutdown(wait=False, cancel_futures=True)
     for process in processes:
         process.terminate()
     for process in processes:
         process.join(2.0)
+        if process.is_alive():  # deaf to SIGTERM (stuck in compiled code)
+            process.kill()
+            process.join(1.0)
+    if results is not None and not any(p.is_alive() for p in processes):
+        results._writer.close()
 
 
 class StopFlag:

@@ -134,6 +134,9 @@ def test_a_crowded_scene_compiles_within_its_time_budget():
                    for x, y in centres]}
     started = time.perf_counter()
     report = run_plan(crowded, PlanOptions(time=1.0))
-    assert time.perf_counter() - started < 1.5 and report.iterations > 0
-    compiling = 1.0 - report.planning_time_s  # what compiling took of the budget
+    took = time.perf_counter() - started
+    # Within the budget plus what a loaded runner's scheduler adds; without compiling in the
+    # budget it would be 1 s plus compiling.
+    assert took < 1.5 and report.iterations > 0
+    compiling = took - report.planning_time_s
     assert 0.0 < compiling < 0.9

@@ -8,6 +8,7 @@ import re
 import signal
 import socket
 import subprocess
+import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -45,6 +46,28 @@ def test_data_survive_a_restart_and_an_interrupted_job_is_marked(tmp_path):
         assert interrupted["done"] < interrupted["total"]
     finally:
         assert second.stop(signal.SIGINT) < 5
+
+
+STOP_MID_WRITE = """
+import time
+from concurrent.futures import ProcessPoolExecutor
+import multiprocessing
+from app.pool import stop_pool
+
+pool = ProcessPoolExecutor(2, multiprocessing.get_context("spawn"))
+futures = [pool.submit(bytes, 20_000_000) for _ in range(400)]
+futures[0].result()
+time.sleep(0.3)  # both workers keep writing results now
+stop_pool(pool)
+"""
+
+
+def test_a_pool_stopped_while_its_workers_write_results_lets_the_process_exit():
+    """SIGTERM once hung the server: a worker terminated mid-write left half a result in the
+    pipe, and the interpreter's exit waited for the rest for ever."""
+    r = subprocess.run([sys.executable, "-c", STOP_MID_WRITE], capture_output=True, text=True,
+                       timeout=30, cwd=ROOT, check=False)
+    assert r.returncode == 0, r.stderr
 
 
 def _alive(pid: int) -> bool:
