@@ -434,6 +434,8 @@ def test_drive_car_moves_the_footprint_along_the_best_path(browser, ui_url):
     page.get_by_label("Footprint", exact=True).click()
     page.get_by_role("option", name="rectangle").click()
     page.get_by_text("Car length (m)").wait_for()
+    # Applying the car resets the planner: a Run clicked before then would be cleared.
+    page.get_by_text("Planned, driven and simulated with this car.").wait_for(timeout=30000)
     click(page, "Run")
     solved = wait_until(page, lambda img: pink_pixels(img) > 200, timeout=60)
     assert pink_pixels(solved) > 200, "no best path for the rectangle car within 60 s"

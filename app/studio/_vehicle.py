@@ -17,6 +17,7 @@ __all__ = ["APPLIED", "FOOTPRINTS", "VehicleForm", "fields_of", "vehicle_from_fi
 
 FOOTPRINTS = ("disc", "rectangle")
 APPLIED = "Planned, driven and simulated with this car."
+APPLYING = "Applying this car…"
 
 
 def fields_of(vehicle: Vehicle) -> dict:
@@ -82,6 +83,9 @@ class VehicleForm:
     def edited(self) -> None:
         if self._filling:
             return
+        # Said first, so that a browser that sees the new fields sees this too, and a Run
+        # clicked before the car is applied can tell (applying resets the planner).
+        self.note.content = APPLYING
         self._show_shape()
         try:
             vehicle = vehicle_from_fields(self._vehicle(), {
