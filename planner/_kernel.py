@@ -27,7 +27,7 @@ import numpy as np
 from planner._dubins import turning_centres
 from planner._goal import in_goal
 from planner._jit import njit
-from planner._paths import path_end, truncate, wrap_angle
+from planner._paths import path_buffers, path_end, truncate, wrap_angle
 from planner._polish import PASSES, polish_path
 from planner._rng import uniform
 from planner._steer import (
@@ -85,8 +85,9 @@ class Tree(NamedTuple):
     # right x, y): Dubins lengths and bounds then need no trigonometry
     cost: np.ndarray  # (cap,) driven length from the root
     parent: np.ndarray  # (cap,) int64, -1 for the root
-    kinds: np.ndarray  # (cap, 5) int8: the edge from the parent
-    lens: np.ndarray  # (cap, 5)
+    kinds: np.ndarray  # (cap, S) int8: the edge from the parent (`planner._paths`), S the
+    lens: np.ndarray  # (cap, S)        steering's segments
+    curv: np.ndarray  # (cap, S, 2)
     first_child: np.ndarray  # (cap,) int64
     next_sibling: np.ndarray  # (cap,) int64
     cell_head: np.ndarray  # (nx * ny,) int64
@@ -112,12 +113,14 @@ class Events(NamedTuple):
     cnt: np.ndarray  # int64[4]: rows, near entries, rewires, polished nodes used
 
 
-def new_tree(capacity: int, grid: np.ndarray, rng: np.ndarray) -> Tree:
+def new_tree(capacity: int, grid: np.ndarray, rng: np.ndarray, segments: int) -> Tree:
+    """An empty tree whose edges have up to ``segments`` segments (the steering's)."""
     nx, ny = int(grid[3]), int(grid[4])
     return Tree(
         pose=np.zeros((capacity, 3)), trig=np.zeros((capacity, 6)), cost=np.zeros(capacity),
-        parent=np.full(capacity, -1, np.int64), kinds=np.zeros((capacity, 5), np.int8),
-        lens=np.zeros((capacity, 5)), first_child=np.full(capacity, -1, np.int64),
+        parent=np.full(capacity, -1, np.int64), kinds=np.zeros((capacity, segments), np.int8),
+        lens=np.zeros((capacity, segments)), curv=np.zeros((capacity, segments, 2)),
+        first_child=np.full(capacity, -1, np.int64),
         next_sibling=np.full(capacity, -1, np.int64), cell_head=np.full(nx * ny, -1, np.int64),
         cell_next=np.full(capacity, -1, np.int64), grid=grid,
         goal_nodes=np.zeros(capacity, np.int64), improved=np.zeros((capacity, 2)),
@@ -135,7 +138,7 @@ def grown(tree: Tree, capacity: int) -> Tree:
 
     return tree._replace(
         pose=pad(tree.pose, 0.0), trig=pad(tree.trig, 0.0), cost=pad(tree.cost, 0.0), parent=pad(tree.parent, -1),
-        kinds=pad(tree.kinds, 0), lens=pad(tree.lens, 0.0),
+        kinds=pad(tree.kinds, 0), lens=pad(tree.lens, 0.0), curv=pad(tree.curv, 0.0),
         first_child=pad(tree.first_child, -1), next_sibling=pad(tree.next_sibling, -1),
         cell_next=pad(tree.cell_next, -1), goal_nodes=pad(tree.goal_nodes, 0),
         improved=pad(tree.improved, 0.0),
@@ -152,7 +155,7 @@ def _cell(tree: Tree, x: float, y: float):
 
 
 @njit(cache=True)
-def add_node(tree: Tree, P: np.ndarray, x, y, th, cost, parent, kinds, lens) -> int:
+def add_node(tree: Tree, P: np.ndarray, x, y, th, cost, parent, kinds, lens, curv) -> int:
     """Append a node (the caller has checked capacity); returns its index."""
     k = tree.cnt[N]
     tree.pose[k, 0] = x
@@ -166,6 +169,7 @@ def add_node(tree: Tree, P: np.ndarray, x, y, th, cost, parent, kinds, lens) -> 
     tree.parent[k] = parent
     tree.kinds[k, :] = kinds
     tree.lens[k, :] = lens
+    tree.curv[k, :, :] = curv
     tree.first_child[k] = -1
     if parent >= 0:
         tree.next_sibling[k] = tree.first_child[parent]
@@ -495,7 +499,8 @@ def _subtree_free_at(tree: Tree, w: World, P: np.ndarray, n: int, delta: float,
         t0 = (tree.cost[par] - delta) / P[SPEED]
         tree.cnt[CHECKS] += 1
         if not motion_free(w, tree.pose[par, 0], tree.pose[par, 1], tree.pose[par, 2], t0,
-                           tree.kinds[node], tree.lens[node], P[RHO], P[SPEED], counter):
+                           tree.kinds[node], tree.lens[node], tree.curv[node], P[SPEED],
+                           counter):
             return False
     return True
 
@@ -522,11 +527,11 @@ def polish(tree: Tree, w: World, P: np.ndarray, ev, cap: int) -> None:
     """The polish `iterate` stopped for (POLISH_DUE), within what is left of polishing's share
     of the run's clearance evaluations and within ``cap`` of them (what a time budget has left
     room for); the next one is due at twice the iterations."""
-    kinds = np.zeros(5, np.int8)
-    lens = np.zeros(5)
+    kinds, lens, curv = path_buffers(tree.lens.shape[1])
     counter = np.zeros(1, np.int64)
     tree.cnt[POLISH_AT] = 2 * tree.cnt[ITER]
-    if _polish_best(tree, w, P, kinds, lens, counter, ev, min(_polish_allowance(tree), cap)):
+    if _polish_best(tree, w, P, kinds, lens, curv, counter, ev,
+                    min(_polish_allowance(tree), cap)):
         _update_best(tree)
     tree.cnt[POLISHED] = int(tree.cost[tree.cnt[BEST]] * 1e6)
     tree.cnt[POLISHED_AT] = tree.cnt[ITER]
@@ -546,7 +551,7 @@ def _polish_allowance(tree: Tree) -> int:
 
 
 @njit(cache=True)
-def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, counter, ev,
+def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, curv, counter, ev,
                  limit: int) -> bool:
     """Polish the best path (`planner._polish`, at most ``limit`` clearance evaluations) and,
     if that shortens it, add the polished poses to the tree as a chain from the root: the tree
@@ -560,16 +565,16 @@ def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, counter, ev,
     root = nodes[0]
     code = int(P[STEERING])
     goal = np.array([P[GX], P[GY], P[GTH], P[GPOS], P[GHEAD]])
-    poses, length = polish_path(w, code, P[RHO], P[SPEED], poses, goal, kinds, lens, counter,
-                                tree.cnt[ITER] >= BLOCKS_FROM, limit)
+    poses, length = polish_path(w, code, P[RHO], P[SPEED], poses, goal, (kinds, lens, curv),
+                                counter, tree.cnt[ITER] >= BLOCKS_FROM, limit)
     if length >= tree.cost[tree.cnt[BEST]] - 1e-9:
         return False
     parent = root
     for i in range(1, poses.shape[0]):
         a, b = poses[i - 1], poses[i]
-        edge = steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], P[RHO], kinds, lens)
+        edge = steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], P[RHO], kinds, lens, curv)
         parent = add_node(tree, P, b[0], b[1], b[2], tree.cost[parent] + edge, parent, kinds,
-                          lens)
+                          lens, curv)
         if ev.rows.shape[0] > 0 and ev.cnt[3] < ev.polished.shape[0]:
             ev.polished[ev.cnt[3]] = parent
             ev.cnt[3] += 1
@@ -609,14 +614,14 @@ def _update_best(tree: Tree) -> None:
 
 @njit(cache=True)
 def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, kinds, lens,
-                   pk, pl, counter):
+                   curv, pk, pl, pc, counter):
     """Cheapest collision-free parent among the near candidates, best first.
 
     Candidates enter a min-heap keyed by cost(j) + a lower bound of their path to x_new; a
     popped bound is replaced by the exact length (re-queued as ``-1 - j``), a popped exact key
     is the cheapest remaining candidate and gets its motion check. So exact lengths are
     computed only for candidates whose bound beats the answer. Returns (cost, parent) and
-    leaves the winning edge in kinds/lens.
+    leaves the winning edge in kinds/lens/curv (pk/pl/pc: scratch).
     """
     keys, vals = tree.near_key, tree.stack
     code, rho = int(P[STEERING]), P[RHO]
@@ -642,12 +647,12 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
             if d < bound:
                 size = _heap_push(keys, vals, size, tree.cost[j] + d, -1 - j)
             continue
-        steer_path(code, px, py, pth, x, y, th, rho, pk, pl)
+        steer_path(code, px, py, pth, x, y, th, rho, pk, pl, pc)
         tree.cnt[CHECKS] += 1
-        if motion_free(w, px, py, pth, tree.cost[j] / P[SPEED], pk, pl, P[RHO], P[SPEED],
-                       counter):
+        if motion_free(w, px, py, pth, tree.cost[j] / P[SPEED], pk, pl, pc, P[SPEED], counter):
             kinds[:] = pk
             lens[:] = pl
+            curv[:, :] = pc
             return key, j
     return c_new, parent
 
@@ -661,11 +666,9 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
     Every iteration draws one sample, whether or not it adds a node (as OMPL counts them).
     """
     record = ev.rows.shape[0] > 0
-    kinds = np.zeros(5, np.int8)
-    lens = np.zeros(5)
-    cut = np.zeros(5)
-    scratch_k = np.zeros(5, np.int8)
-    scratch_l = np.zeros(5)
+    kinds, lens, curv = path_buffers(tree.lens.shape[1])
+    scratch_k, scratch_l, scratch_c = path_buffers(tree.lens.shape[1])
+    cut = np.zeros(tree.lens.shape[1])
     counter = np.zeros(1, np.int64)
     timed = w.m_kind.shape[0] > 0
     code = int(P[STEERING])
@@ -700,14 +703,14 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
         near_i, dist = nearest(tree, P, xr, yr, thr)
         nx0, ny0, nth0 = tree.pose[near_i, 0], tree.pose[near_i, 1], tree.pose[near_i, 2]
         thr = arrival_heading(code, nx0, ny0, nth0, xr, yr, thr)
-        length = steer_path(code, nx0, ny0, nth0, xr, yr, thr, P[RHO], kinds, lens)
+        length = steer_path(code, nx0, ny0, nth0, xr, yr, thr, P[RHO], kinds, lens, curv)
         if P[METRIC] == SE2_METRIC:
             dist = length  # the metric chose the node; the edge is driven by the steering
         if dist > P[EPS]:
             truncate(kinds, lens, P[EPS], cut)
             lens[:] = cut
             dist = P[EPS]
-        x, y, th = path_end(nx0, ny0, nth0, kinds, lens, P[RHO])
+        x, y, th = path_end(nx0, ny0, nth0, kinds, lens, curv)
         th = wrap_angle(th)
         if record:
             ev.rows[row, EV_NEAREST] = near_i
@@ -720,7 +723,7 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
         parent = near_i
         c_new = tree.cost[near_i] + dist
         free = free_length(w, nx0, ny0, nth0, tree.cost[near_i] / P[SPEED], kinds, lens,
-                           P[RHO], P[SPEED], counter)
+                           curv, P[SPEED], counter)
         if free != math.inf and not timed:
             if record:
                 ev.rows[row, EV_FREE] = free
@@ -730,7 +733,7 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
             truncate(kinds, lens, dist, cut)
             lens[:] = cut
             c_new = tree.cost[near_i] + dist
-            x, y, th = path_end(nx0, ny0, nth0, kinds, lens, P[RHO])
+            x, y, th = path_end(nx0, ny0, nth0, kinds, lens, curv)
             th = wrap_angle(th)
         elif free != math.inf:
             if P[STAR] == 0.0:
@@ -750,10 +753,11 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
                 radius = min(P[GAMMA] * (math.log(n) / n) ** (1.0 / P[DIMS]), P[EPS])
                 m = _near(tree, x, y, radius, 0)
             c_new, parent = _choose_parent(tree, w, P, m, x, y, th, radius, c_new, parent,
-                                           kinds, lens, scratch_k, scratch_l, counter)
+                                           kinds, lens, curv, scratch_k, scratch_l, scratch_c,
+                                           counter)
             if parent < 0:
                 continue
-        new = add_node(tree, P, x, y, th, c_new, parent, kinds, lens)
+        new = add_node(tree, P, x, y, th, c_new, parent, kinds, lens, curv)
         changed = tree.cnt[NGOAL] > 0 and tree.goal_nodes[tree.cnt[NGOAL] - 1] == new
         if record:
             ev.rows[row, EV_NEW] = new
@@ -779,9 +783,9 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
             if l >= budget - 1e-9:
                 continue
             steer_path(code, x, y, th, tree.pose[j, 0], tree.pose[j, 1],
-                       tree.pose[j, 2], P[RHO], kinds, lens)
+                       tree.pose[j, 2], P[RHO], kinds, lens, curv)
             tree.cnt[CHECKS] += 1
-            if not motion_free(w, x, y, th, c_new / P[SPEED], kinds, lens, P[RHO], P[SPEED],
+            if not motion_free(w, x, y, th, c_new / P[SPEED], kinds, lens, curv, P[SPEED],
                                counter):
                 continue
             delta = tree.cost[j] - (c_new + l)
@@ -796,6 +800,7 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
             tree.first_child[new] = j
             tree.kinds[j, :] = kinds
             tree.lens[j, :] = lens
+            tree.curv[j, :, :] = curv
             for k in range(n_sub):  # the whole subtree arrives earlier by the same Δ
                 tree.cost[tree.stack[k]] -= delta
             tree.cnt[REWIRES] += 1

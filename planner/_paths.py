@@ -1,15 +1,24 @@
-"""Local motions as at most five segments — the one representation every steering writes.
+"""Local motions as a few segments — the one representation every steering writes.
 
-``kinds`` (int8[5]: +1 left arc, 0 straight, -1 right arc, 2 turn on the spot) and ``lens``
-(float64[5]: signed arc length in metres, negative = reversing; for a turn on the spot the
-signed angle in radians, which drives no length; unused slots are 0). Arcs have radius ``rho``.
-Everything downstream — sampling, collision checks, curvature profiles — reads only this form,
-so all steering functions share one integrator. A turn on the spot is taken when the motion goes
-on past it: the pose at driven length 0 is the start pose, the pose at the end of the last
-driven segment has not yet taken a turn that follows it.
+A path is three arrays of one width (the steering's ``segments``, see `planner.steering`):
 
-The pose update along a segment is exact (no numerical integration): for a left arc of signed
-length l, θ' = θ + l/ρ, x' = x + ρ(sin θ' − sin θ), y' = y − ρ(cos θ' − cos θ).
+- ``kinds`` (int8): which way the segment turns, +1 left, 0 straight, -1 right, 2 turn on the
+  spot — the letter of the path's word (`path_word`);
+- ``lens`` (float64): its signed driven length in metres, negative = reversing; for a turn on
+  the spot the signed angle in radians, which drives no length; unused slots are 0;
+- ``curv`` (float64, two columns): its steering curvature κ0 where it starts (1/m, positive
+  = the wheels turned left) and its sharpness σ = dκ/du (1/m², u the driven distance). An arc
+  of radius ρ is (±1/ρ, 0), a straight (0, 0), a clothoid ramps κ at σ.
+
+Everything downstream — sampling, collision checks, curvature profiles, re-rooting, drawing —
+reads only this form through `advance` and `curvature_at`, so all steering functions share one
+integrator. A turn on the spot is taken when the motion goes on past it: the pose at driven
+length 0 is the start pose, the pose at the end of the last driven segment has not yet taken a
+turn that follows it.
+
+The pose update along a segment is exact (no numerical integration): for an arc of signed
+length l and curvature κ, θ' = θ + κl, x' = x + (sin θ' − sin θ)/κ, y' = y − (cos θ' − cos θ)/κ;
+a clothoid's is `planner._clothoid.clothoid_pose` (Fresnel integrals).
 """
 
 from __future__ import annotations
@@ -18,9 +27,9 @@ import math
 
 import numpy as np
 
+from planner._clothoid import clothoid_pose
 from planner._jit import njit
 
-MAX_SEGMENTS = 5
 LEFT, STRAIGHT, RIGHT, TURN = 1, 0, -1, 2
 _TWO_PI = 2.0 * math.pi
 MIN_SEGMENT = 1e-9  # m: a shorter driven segment (a Dubins word's vanishing middle) is none
@@ -49,17 +58,46 @@ def path_word(kinds, lens) -> str:
 
 
 @njit(cache=True, inline="always")
-def advance(x: float, y: float, th: float, kind: int, length: float, rho: float):
-    """Pose after driving ``length`` (signed) on one segment of ``kind`` from (x, y, th); for
-    a turn on the spot, ``length`` is its angle."""
-    if kind == STRAIGHT:
-        return x + length * math.cos(th), y + length * math.sin(th), th
+def advance(x: float, y: float, th: float, kind: int, length: float, k0: float, sigma: float):
+    """Pose after driving ``length`` (signed) on one segment from (x, y, th): of ``kind`` (a
+    turn on the spot turns by the angle ``length``), start curvature ``k0``, sharpness
+    ``sigma``."""
     if kind == TURN:
         return x, y, th + length
-    th2 = th + kind * length / rho
-    x2 = x + kind * rho * (math.sin(th2) - math.sin(th))
-    y2 = y - kind * rho * (math.cos(th2) - math.cos(th))
-    return x2, y2, th2
+    if sigma != 0.0:
+        return clothoid_pose(x, y, th, k0, sigma, length)
+    if k0 == 0.0:
+        return x + length * math.cos(th), y + length * math.sin(th), th
+    th2 = th + k0 * length
+    return x + (math.sin(th2) - math.sin(th)) / k0, y - (math.cos(th2) - math.cos(th)) / k0, th2
+
+
+@njit(cache=True, inline="always")
+def curvature_at(kind: int, k0: float, sigma: float, u: float) -> float:
+    """Steering curvature ``u`` metres into a segment (0 on the spot: the robot does not
+    steer, its heading is free)."""
+    return 0.0 if kind == TURN else k0 + sigma * u
+
+
+@njit(cache=True, inline="always")
+def peak_curvature(kind: int, length: float, k0: float, sigma: float) -> float:
+    """The most |κ| a segment reaches: at one of its ends (κ is linear in u)."""
+    return 0.0 if kind == TURN else max(abs(k0), abs(k0 + sigma * abs(length)))
+
+
+@njit(cache=True, inline="always")
+def path_buffers(segments: int):
+    """Zeroed kinds, lens and curv for one path of ``segments`` segments."""
+    return np.zeros(segments, np.int8), np.zeros(segments), np.zeros((segments, 2))
+
+
+@njit(cache=True)
+def arc_curvatures(kinds: np.ndarray, rho: float, curv: np.ndarray) -> None:
+    """``curv`` of a path of arcs of radius ρ and straights (Dubins, Reeds-Shepp, straight
+    lines): κ0 = kind/ρ, σ = 0."""
+    for i in range(kinds.shape[0]):
+        curv[i, 0] = 0.0 if kinds[i] == TURN else kinds[i] / rho
+        curv[i, 1] = 0.0
 
 
 @njit(cache=True, inline="always")
@@ -78,8 +116,8 @@ def path_length(kinds: np.ndarray, lens: np.ndarray) -> float:
 
 
 @njit(cache=True)
-def pose_at(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray, rho: float,
-            s: float):
+def pose_at(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray,
+            curv: np.ndarray, s: float):
     """Pose at driven length ``s`` (0 ≤ s ≤ path length) along the path from (x, y, th).
 
     Returns (x, y, theta, kind, direction) where kind is the segment's steering (+1/0/-1) and
@@ -99,25 +137,27 @@ def pose_at(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray, 
         kind = kinds[i]
         direction = 1.0 if seg > 0.0 else -1.0
         if remaining <= abs(seg):
-            x, y, th = advance(x, y, th, kind, direction * remaining, rho)
+            x, y, th = advance(x, y, th, kind, direction * remaining, curv[i, 0], curv[i, 1])
             return x, y, th, kind, direction
-        x, y, th = advance(x, y, th, kind, seg, rho)
+        x, y, th = advance(x, y, th, kind, seg, curv[i, 0], curv[i, 1])
         remaining -= abs(seg)
     return x, y, th, kind, direction
 
 
 @njit(cache=True)
-def path_end(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray, rho: float):
+def path_end(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray,
+             curv: np.ndarray):
     """End pose of the path (heading not wrapped)."""
     for i in range(kinds.shape[0]):
         if lens[i] != 0.0:
-            x, y, th = advance(x, y, th, kinds[i], lens[i], rho)
+            x, y, th = advance(x, y, th, kinds[i], lens[i], curv[i, 0], curv[i, 1])
     return x, y, th
 
 
 @njit(cache=True)
 def truncate(kinds: np.ndarray, lens: np.ndarray, s: float, out_lens: np.ndarray) -> None:
-    """Write into ``out_lens`` the first ``s`` metres of the path (same kinds)."""
+    """Write into ``out_lens`` the first ``s`` metres of the path (same kinds and curvatures:
+    a segment cut short starts as it did)."""
     remaining = s
     for i in range(kinds.shape[0]):
         seg = lens[i]
@@ -130,11 +170,12 @@ def truncate(kinds: np.ndarray, lens: np.ndarray, s: float, out_lens: np.ndarray
 
 
 @njit(cache=True)
-def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray, rho: float,
-                spacing: float) -> np.ndarray:
+def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray,
+                curv: np.ndarray, spacing: float) -> np.ndarray:
     """Poses every ≤ ``spacing`` metres, both ends and every segment joint included.
 
-    Returns an (n, 5) array of x, y, theta, curvature (steering curvature: kind/ρ), direction.
+    Returns an (n, 5) array of x, y, theta, curvature (the steering curvature there; at a
+    joint, the segment's that ends there), direction.
     A turn on the spot is one row: the same position, the new heading, curvature 0 (the robot
     does not steer; its heading is free). A segment under `MIN_SEGMENT` (a Dubins word's
     vanishing middle) moves the pose but gives no row: it would repeat the one before.
@@ -149,35 +190,32 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
     out[0, 0] = x
     out[0, 1] = y
     out[0, 2] = th
-    out[0, 3] = _curvature(kinds[first], rho) if first >= 0 else 0.0
+    out[0, 3] = curvature_at(kinds[first], curv[first, 0], 0.0, 0.0) if first >= 0 else 0.0
     out[0, 4] = _direction(kinds[first], lens[first]) if first >= 0 else 1.0
     k = 1
     for i in range(kinds.shape[0]):
         seg = lens[i]
+        k0, sigma = curv[i, 0], curv[i, 1]
         if not _sampled(kinds[i], seg):
-            x, y, th = advance(x, y, th, kinds[i], seg, rho)
+            x, y, th = advance(x, y, th, kinds[i], seg, k0, sigma)
             continue
         steps = max(1, int(math.ceil(driven(kinds[i], seg) / spacing - 1e-12)))
         for j in range(1, steps + 1):
-            px, py, pth = advance(x, y, th, kinds[i], seg * j / steps, rho)
+            part = seg * j / steps
+            px, py, pth = advance(x, y, th, kinds[i], part, k0, sigma)
             out[k, 0] = px
             out[k, 1] = py
             out[k, 2] = pth
-            out[k, 3] = _curvature(kinds[i], rho)
+            out[k, 3] = curvature_at(kinds[i], k0, sigma, abs(part))
             out[k, 4] = _direction(kinds[i], seg)
             k += 1
-        x, y, th = advance(x, y, th, kinds[i], seg, rho)
+        x, y, th = advance(x, y, th, kinds[i], seg, k0, sigma)
     return out
 
 
 @njit(cache=True, inline="always")
 def _sampled(kind: int, seg: float) -> bool:
     return seg != 0.0 and (kind == TURN or abs(seg) > MIN_SEGMENT)
-
-
-@njit(cache=True, inline="always")
-def _curvature(kind: int, rho: float) -> float:
-    return 0.0 if kind == TURN else kind / rho
 
 
 @njit(cache=True, inline="always")

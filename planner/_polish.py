@@ -51,28 +51,30 @@ def _length(code: int, a, b, rho: float, bound: float) -> float:
 
 
 @njit(cache=True)
-def _free(w: World, code: int, a, b, rho: float, speed: float, kinds, lens, counter) -> bool:
-    steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], rho, kinds, lens)
-    return motion_free(w, a[0], a[1], a[2], 0.0, kinds, lens, rho, speed, counter)
+def _free(w: World, code: int, a, b, rho: float, speed: float, buf, counter) -> bool:
+    kinds, lens, curv = buf
+    steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], rho, kinds, lens, curv)
+    return motion_free(w, a[0], a[1], a[2], 0.0, kinds, lens, curv, speed, counter)
 
 
 @njit(cache=True)
 def polish_path(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
-                goal: np.ndarray, kinds, lens, counter, blocks: bool, limit: int):
+                goal: np.ndarray, buf, counter, blocks: bool, limit: int):
     """The path through ``poses`` ((n, 3)) shortened: (new poses, their length); with
     ``blocks``, each pass also shifts blocks of poses (`_shift_blocks`), which costs a polish
     about twice as much. It stops between two rounds once ``counter`` has passed ``limit``
-    clearance evaluations: every step keeps the path free, so where it stops is a path."""
+    clearance evaluations: every step keeps the path free, so where it stops is a path.
+    ``buf``: (kinds, lens, curv), room for one local path (`planner._paths`)."""
     for _ in range(PASSES):
-        poses = _split(code, rho, poses, kinds, lens)
-        _descend(w, code, rho, speed, poses, goal, kinds, lens, counter, limit)
+        poses = _split(code, rho, poses, buf)
+        _descend(w, code, rho, speed, poses, goal, buf, counter, limit)
         if blocks:
             for width in BLOCKS:
-                _shift_blocks(w, code, rho, speed, poses, width, kinds, lens, counter, limit)
-            _descend(w, code, rho, speed, poses, goal, kinds, lens, counter, limit)
+                _shift_blocks(w, code, rho, speed, poses, width, buf, counter, limit)
+            _descend(w, code, rho, speed, poses, goal, buf, counter, limit)
         if counter[0] > limit:
             break
-        poses = _prune(w, code, rho, speed, poses, kinds, lens, counter)
+        poses = _prune(w, code, rho, speed, poses, buf, counter)
     total = 0.0
     for i in range(poses.shape[0] - 1):
         total += _length(code, poses[i], poses[i + 1], rho, math.inf)
@@ -80,7 +82,7 @@ def polish_path(w: World, code: int, rho: float, speed: float, poses: np.ndarray
 
 
 @njit(cache=True)
-def _split(code: int, rho: float, poses: np.ndarray, kinds, lens) -> np.ndarray:
+def _split(code: int, rho: float, poses: np.ndarray, buf) -> np.ndarray:
     """Every edge of `SPLIT_MIN`·2ρ or more cut in two at the pose halfway along it (the path
     itself is unchanged). Shorter edges stay whole: a polish that stops at its budget keeps its
     split poses, and splitting every edge each time grew a corridor's best path to 7 446 poses
@@ -92,9 +94,9 @@ def _split(code: int, rho: float, poses: np.ndarray, kinds, lens) -> np.ndarray:
         a, b = poses[i], poses[i + 1]
         out[k, :] = a
         k += 1
-        length = steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], rho, kinds, lens)
+        length = steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], rho, buf[0], buf[1], buf[2])
         if length >= 2.0 * SPLIT_MIN * rho:
-            x, y, th, _, _ = pose_at(a[0], a[1], a[2], kinds, lens, rho, 0.5 * length)
+            x, y, th, _, _ = pose_at(a[0], a[1], a[2], buf[0], buf[1], buf[2], 0.5 * length)
             out[k, 0] = x
             out[k, 1] = y
             out[k, 2] = wrap_angle(th)
@@ -118,7 +120,7 @@ def _edges(code: int, poses: np.ndarray, rho: float) -> tuple[np.ndarray, float]
 
 @njit(cache=True)
 def _descend(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
-             goal: np.ndarray, kinds, lens, counter, limit: int) -> None:
+             goal: np.ndarray, buf, counter, limit: int) -> None:
     """Coordinate descent on the inner poses and the end pose (within the goal), in place:
     each round moves every pose by the step that shortens its edges most and is free."""
     n = poses.shape[0]
@@ -150,10 +152,10 @@ def _descend(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
             for m in np.argsort(-gain):
                 if gain[m] <= 1e-9:
                     break
-                if not _free(w, code, poses[i - 1], cand[m], rho, speed, kinds, lens, counter):
+                if not _free(w, code, poses[i - 1], cand[m], rho, speed, buf, counter):
                     continue
-                if not last and not _free(w, code, cand[m], poses[i + 1], rho, speed, kinds,
-                                          lens, counter):
+                if not last and not _free(w, code, cand[m], poses[i + 1], rho, speed, buf,
+                                          counter):
                     continue
                 poses[i, :] = cand[m]
                 edge[i - 1] = new_a[m]
@@ -166,7 +168,7 @@ def _descend(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
 
 @njit(cache=True)
 def _shift_blocks(w: World, code: int, rho: float, speed: float, poses: np.ndarray, width: int,
-                  kinds, lens, counter, limit: int) -> None:
+                  buf, counter, limit: int) -> None:
     """Coordinate descent on blocks of ``width`` inner poses shifted together, in place. A
     path that bulges round an obstacle between poses too far apart for any one of them to move
     freely can move as a whole; a shift keeps the steered edges inside the block."""
@@ -202,12 +204,12 @@ def _shift_blocks(w: World, code: int, rho: float, speed: float, poses: np.ndarr
                 moved[k, 0] = poses[i + k, 0] + SHIFTS[pick, 0] * step
                 moved[k, 1] = poses[i + k, 1] + SHIFTS[pick, 1] * step
                 moved[k, 2] = poses[i + k, 2]
-            free = (_free(w, code, poses[i - 1], moved[0], rho, speed, kinds, lens, counter)
-                    and _free(w, code, moved[width - 1], poses[j + 1], rho, speed, kinds, lens,
+            free = (_free(w, code, poses[i - 1], moved[0], rho, speed, buf, counter)
+                    and _free(w, code, moved[width - 1], poses[j + 1], rho, speed, buf,
                               counter))
             k = 0
             while free and k < width - 1:
-                free = _free(w, code, moved[k], moved[k + 1], rho, speed, kinds, lens, counter)
+                free = _free(w, code, moved[k], moved[k + 1], rho, speed, buf, counter)
                 k += 1
             if free:
                 poses[i:j + 1, :] = moved
@@ -217,7 +219,7 @@ def _shift_blocks(w: World, code: int, rho: float, speed: float, poses: np.ndarr
 
 
 @njit(cache=True)
-def _prune(w: World, code: int, rho: float, speed: float, poses: np.ndarray, kinds, lens,
+def _prune(w: World, code: int, rho: float, speed: float, poses: np.ndarray, buf,
            counter) -> np.ndarray:
     """The poses the path can skip dropped: from each kept pose, straight on to the farthest
     later pose (of the next `LOOKAHEAD`) that one free steered edge reaches more shortly than
@@ -234,7 +236,7 @@ def _prune(w: World, code: int, rho: float, speed: float, poses: np.ndarray, kin
         for j in range(min(n - 1, i + LOOKAHEAD), i + 1, -1):
             via = along[j] - along[i]
             if (_length(code, poses[i], poses[j], rho, via) < via - 1e-9
-                    and _free(w, code, poses[i], poses[j], rho, speed, kinds, lens, counter)):
+                    and _free(w, code, poses[i], poses[j], rho, speed, buf, counter)):
                 nxt = j
                 break
         keep[kept] = nxt

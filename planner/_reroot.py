@@ -14,22 +14,25 @@ import numpy as np
 
 from planner import _kernel as K
 from planner._jit import njit
-from planner._paths import TURN
+from planner._paths import TURN, curvature_at, path_buffers
 from planner._world import World, motion_free
 
 
 @njit(cache=True)
-def _tail(kinds, lens, skip, out):
-    """Into ``out`` the segments left after driving ``skip`` metres along (kinds, lens)."""
+def _tail(kinds, lens, curv, skip, out_lens, out_curv):
+    """Into ``out_lens``/``out_curv`` the segments left after driving ``skip`` metres along
+    (kinds, lens, curv): a segment entered part way starts at the curvature reached there."""
     remaining = skip
     for i in range(lens.shape[0]):
         seg = lens[i]
+        out_curv[i, 0], out_curv[i, 1] = curv[i, 0], curv[i, 1]
         if kinds[i] == TURN:  # taken once the car has gone on past it (see `_paths`)
-            out[i] = 0.0 if remaining > 0.0 else seg
+            out_lens[i] = 0.0 if remaining > 0.0 else seg
             continue
         take = min(abs(seg), max(remaining, 0.0))
         left = abs(seg) - take
-        out[i] = left if seg >= 0.0 else -left
+        out_lens[i] = left if seg >= 0.0 else -left
+        out_curv[i, 0] = curvature_at(kinds[i], curv[i, 0], curv[i, 1], take)
         remaining -= take
 
 
@@ -45,7 +48,7 @@ def reroot(old: K.Tree, new: K.Tree, w: World, P: np.ndarray, anchor: int, skip:
     number of nodes copied; the caller has made room for all of them. Goal nodes are registered
     by `add_node`; the caller updates the best node.
     """
-    rho, speed = P[K.RHO], P[K.SPEED]
+    speed = P[K.SPEED]
     stack = np.empty(old.cnt[K.N] + 1, np.int64)  # old node
     mapped = np.empty(old.cnt[K.N] + 1, np.int64)  # its new parent
     top = 0
@@ -62,7 +65,7 @@ def reroot(old: K.Tree, new: K.Tree, w: World, P: np.ndarray, anchor: int, skip:
             mapped[top] = 0
             top += 1
             c = old.next_sibling[c]
-    lens = np.zeros(5)
+    _, lens, curv = path_buffers(old.lens.shape[1])
     counter = np.zeros(1, np.int64)
     copied = 0
     while top > 0:
@@ -70,18 +73,19 @@ def reroot(old: K.Tree, new: K.Tree, w: World, P: np.ndarray, anchor: int, skip:
         node = stack[top]
         par_new = mapped[top]
         if skip > 0.0 and node == anchor:
-            _tail(old.kinds[node], old.lens[node], skip, lens)
+            _tail(old.kinds[node], old.lens[node], old.curv[node], skip, lens, curv)
         else:
             lens[:] = old.lens[node]
+            curv[:, :] = old.curv[node]
         cost = old.cost[node] - base
         if cost + np.hypot(old.pose[node, 0] - P[K.GX], old.pose[node, 1] - P[K.GY]) > bound:
             continue
         px, py, pth = new.pose[par_new, 0], new.pose[par_new, 1], new.pose[par_new, 2]
         if not motion_free(w, px, py, pth, new.cost[par_new] / speed, old.kinds[node], lens,
-                           rho, speed, counter):
+                           curv, speed, counter):
             continue  # this edge became invalid: prune it and everything below
         x, y, th = old.pose[node, 0], old.pose[node, 1], old.pose[node, 2]
-        k = K.add_node(new, P, x, y, th, cost, par_new, old.kinds[node], lens)
+        k = K.add_node(new, P, x, y, th, cost, par_new, old.kinds[node], lens, curv)
         copied += 1
         c = old.first_child[node]
         while c >= 0:

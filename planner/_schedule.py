@@ -8,7 +8,7 @@ earliest arrival on the grid is within one dt per wait of the continuous optimum
 breadth-first in time, so the first layer that reaches the last station is the earliest arrival.
 
 Each move is certified exactly, like `planner._world.motion_free`: the footprint's clearance
-from the movers drops by at most (1 + reach/ρ) per metre driven (a disc at offset a from the
+from the movers drops by at most (1 + reach·|κ|max) per metre driven (a disc at offset a from the
 pose moves at most that far) plus the movers' top speed per second, so from a clearance c the
 move is free for the next c / (that rate) of it; the move is refused once c ≤ ``CONTACT``.
 No collision slips between stations or between instants, waits included. The static obstacles
@@ -20,35 +20,36 @@ from __future__ import annotations
 import numpy as np
 
 from planner._jit import njit
-from planner._paths import advance
+from planner._paths import advance, peak_curvature
 from planner._world import CONTACT, REACH, VMAX_OBS, World, moving_clearance
 
 WAITED, DROVE = 1, 2  # how a grid point was first reached
 
 
 @njit(cache=True)
-def pose_on(seg_pose, seg_kind, seg_len, seg_s0, rho, s):
+def pose_on(seg_pose, seg_kind, seg_len, seg_curv, seg_s0, s):
     """Pose at driven length s on a path given as driven segments: each one's start pose,
-    kind, signed length and the driven length where it starts."""
+    kind, signed length, curvatures (`planner._paths`) and the driven length where it
+    starts."""
     k = min(max(np.searchsorted(seg_s0, s, side="right") - 1, 0), seg_s0.shape[0] - 1)
     length = seg_len[k]
     d = min(max(s - seg_s0[k], 0.0), abs(length))
     return advance(seg_pose[k, 0], seg_pose[k, 1], seg_pose[k, 2], seg_kind[k],
-                   d if length >= 0.0 else -d, rho)
+                   d if length >= 0.0 else -d, seg_curv[k, 0], seg_curv[k, 1])
 
 
 @njit(cache=True)
-def station_poses(seg_pose, seg_kind, seg_len, seg_s0, rho, n, ds) -> np.ndarray:
+def station_poses(seg_pose, seg_kind, seg_len, seg_curv, seg_s0, n, ds) -> np.ndarray:
     """(n + 1, 3) poses at s = i·ds."""
     out = np.empty((n + 1, 3))
     for i in range(n + 1):
-        out[i, 0], out[i, 1], out[i, 2] = pose_on(seg_pose, seg_kind, seg_len, seg_s0, rho,
+        out[i, 0], out[i, 1], out[i, 2] = pose_on(seg_pose, seg_kind, seg_len, seg_curv, seg_s0,
                                                   i * ds)
     return out
 
 
 @njit(cache=True)
-def _move_free(w, seg_pose, seg_kind, seg_len, seg_s0, rho, s, t, ds, dt, rate, c):
+def _move_free(w, seg_pose, seg_kind, seg_len, seg_curv, seg_s0, s, t, ds, dt, rate, c):
     """Is the move from (s, t) to (s + ds, t + dt), at constant pace, free of the movers?
     ``c``: the clearance at its start; ``rate``: the most the clearance drops over the move."""
     u = 0.0
@@ -58,14 +59,14 @@ def _move_free(w, seg_pose, seg_kind, seg_len, seg_s0, rho, s, t, ds, dt, rate, 
         u += c / rate
         if u >= 1.0:
             return True
-        x, y, th = pose_on(seg_pose, seg_kind, seg_len, seg_s0, rho, s + u * ds)
+        x, y, th = pose_on(seg_pose, seg_kind, seg_len, seg_curv, seg_s0, s + u * ds)
         c = moving_clearance(w, x, y, th, t + u * dt)
     return False
 
 
 @njit(cache=True)
-def earliest_arrival(w: World, seg_pose, seg_kind, seg_len, seg_s0, rho, n, ds, dt, layers,
-                     waits) -> int:
+def earliest_arrival(w: World, seg_pose, seg_kind, seg_len, seg_curv, seg_s0, n, ds, dt,
+                     layers, waits) -> int:
     """The earliest layer j at which the car, leaving station 0 at t = 0, can be at station n
     (the path's end), or −1 if none up to ``layers``. Fills ``waits[i]``, the instants spent at
     station i, for one such schedule: of the schedules arriving then, one that waits as late as
@@ -74,10 +75,13 @@ def earliest_arrival(w: World, seg_pose, seg_kind, seg_len, seg_s0, rho, n, ds, 
     A clearance c found at station i at layer j certifies both moves from station i for the
     next (c − drive's drop) / (wait's drop) layers too (``sure``): in open space most grid
     points cost no evaluation."""
-    slope = 1.0 + w.geo[REACH] / rho
+    kmax = 0.0
+    for k in range(seg_kind.shape[0]):
+        kmax = max(kmax, peak_curvature(seg_kind[k], seg_len[k], seg_curv[k, 0], seg_curv[k, 1]))
+    slope = 1.0 + w.geo[REACH] * kmax
     drive_rate = slope * ds + w.geo[VMAX_OBS] * dt
     wait_rate = w.geo[VMAX_OBS] * dt
-    poses = station_poses(seg_pose, seg_kind, seg_len, seg_s0, rho, n, ds)
+    poses = station_poses(seg_pose, seg_kind, seg_len, seg_curv, seg_s0, n, ds)
     sure = np.zeros(n + 1, np.int64)  # moves from station i are free before this layer
     state = np.zeros((layers + 1, n + 1), np.uint8)
     state[0, 0] = WAITED
@@ -98,10 +102,10 @@ def earliest_arrival(w: World, seg_pose, seg_kind, seg_len, seg_s0, rho, n, ds, 
                         else layers + 1
                 else:
                     s = i * ds
-                    wait_ok = _move_free(w, seg_pose, seg_kind, seg_len, seg_s0, rho, s, t,
-                                         0.0, dt, wait_rate, c)
-                    drive_ok = i < n and _move_free(w, seg_pose, seg_kind, seg_len, seg_s0,
-                                                    rho, s, t, ds, dt, drive_rate, c)
+                    wait_ok = _move_free(w, seg_pose, seg_kind, seg_len, seg_curv, seg_s0, s,
+                                         t, 0.0, dt, wait_rate, c)
+                    drive_ok = i < n and _move_free(w, seg_pose, seg_kind, seg_len, seg_curv,
+                                                    seg_s0, s, t, ds, dt, drive_rate, c)
             # A wait overrides a drive into the same point (stations run upwards, so the
             # drive from below came first): the backtrack then waits late, not early.
             if wait_ok:

@@ -16,7 +16,7 @@ from planner._dubins import (
     turning_centres,
 )
 from planner._jit import njit
-from planner._paths import wrap_angle
+from planner._paths import arc_curvatures, wrap_angle
 from planner._reeds_shepp import reeds_shepp_length, reeds_shepp_lower_bound, reeds_shepp_path
 from planner._straight import straight_heading, straight_length, straight_path
 from planner.steering import DUBINS, REEDS_SHEPP
@@ -30,13 +30,17 @@ def state(x, y, th, c, s, rho):
 
 
 @njit(cache=True)
-def steer_path(code, x0, y0, th0, x1, y1, th1, rho, kinds, lens) -> float:
-    """Shortest local path between two poses, written into kinds/lens; returns its length."""
+def steer_path(code, x0, y0, th0, x1, y1, th1, rho, kinds, lens, curv) -> float:
+    """Shortest local path between two poses, written into kinds/lens/curv (`planner._paths`);
+    returns its length."""
     if code == DUBINS:
-        return dubins_path(x0, y0, th0, x1, y1, th1, rho, kinds, lens)
-    if code == REEDS_SHEPP:
-        return reeds_shepp_path(x0, y0, th0, x1, y1, th1, rho, kinds, lens)
-    return straight_path(x0, y0, th0, x1, y1, th1, kinds, lens)
+        length = dubins_path(x0, y0, th0, x1, y1, th1, rho, kinds, lens)
+    elif code == REEDS_SHEPP:
+        length = reeds_shepp_path(x0, y0, th0, x1, y1, th1, rho, kinds, lens)
+    else:
+        length = straight_path(x0, y0, th0, x1, y1, th1, kinds, lens)
+    arc_curvatures(kinds, rho, curv)
+    return length
 
 
 @njit(cache=True, inline="always")

@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 from planner._jit import njit
-from planner._paths import TURN, advance
+from planner._paths import TURN, advance, peak_curvature
 
 CONTACT = 1e-4
 # Distance evaluations that filling the clearance grid may take (~1 s): a crowded scene gets
@@ -451,24 +451,28 @@ def clearance_bound(w: World, x: float, y: float, c: float, s: float, t: float) 
 
 
 @njit(cache=True)
-def motion_free(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> bool:
-    """Exact check of a whole segment path driven from time t0 at ``speed``.
+def motion_free(w: World, x, y, th, t0, kinds, lens, curv, speed, counter) -> bool:
+    """Exact check of a whole segment path (`planner._paths`) driven from time t0 at
+    ``speed``.
 
     ``counter`` (int64[1]) accumulates clearance evaluations, for the metrics.
     """
-    return free_length(w, x, y, th, t0, kinds, lens, rho, speed, counter) == math.inf
+    return free_length(w, x, y, th, t0, kinds, lens, curv, speed, counter) == math.inf
 
 
 @njit(cache=True)
-def free_length(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> float:
+def free_length(w: World, x, y, th, t0, kinds, lens, curv, speed, counter) -> float:
     """How far a segment path driven from time t0 at ``speed`` is certified free: +inf for
     all of it, else a driven length short of the first contact (every step before it is free).
 
-    Poses along a segment come from its start's cos and sin: two trigonometric calls per step
-    on an arc, none on a straight.
+    Poses along an arc come from its start's cos and sin: two trigonometric calls per step, none
+    on a straight; along a clothoid from `advance`.
     """
-    # A footprint disc at offset a moves at most (1 + a/ρ) times as far as the car drives.
-    slow = 1.0 + w.geo[VMAX_OBS] / speed + w.geo[REACH] / rho
+    # A footprint disc at offset a moves at most (1 + a·|κ|) times as far as the car drives.
+    kmax = 0.0
+    for i in range(kinds.shape[0]):
+        kmax = max(kmax, peak_curvature(kinds[i], lens[i], curv[i, 0], curv[i, 1]))
+    slow = 1.0 + w.geo[VMAX_OBS] / speed + w.geo[REACH] * kmax
     sdf, sdf_geo, discs = w.sdf, w.sdf_geo, w.discs
     moving = w.m_kind.shape[0] > 0
     driven = 0.0
@@ -481,11 +485,14 @@ def free_length(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> flo
             continue
         length = abs(seg)
         direction = 1.0 if seg > 0.0 else -1.0
-        turn = kinds[i] / rho
+        turn, sigma = curv[i, 0], curv[i, 1]
         c0, s0 = math.cos(th), math.sin(th)
         s = 0.0
         while True:
-            if turn == 0.0:
+            if sigma != 0.0:
+                px, py, pth = advance(x, y, th, kinds[i], direction * s, turn, sigma)
+                c, sn = math.cos(pth), math.sin(pth)
+            elif turn == 0.0:
                 c, sn = c0, s0
                 px, py = x + direction * s * c0, y + direction * s * s0
             else:
@@ -500,7 +507,7 @@ def free_length(w: World, x, y, th, t0, kinds, lens, rho, speed, counter) -> flo
             if s >= length:
                 break
             s = min(length, s + d / slow)
-        x, y, th = advance(x, y, th, kinds[i], seg, rho)
+        x, y, th = advance(x, y, th, kinds[i], seg, turn, sigma)
         driven += length
     return math.inf
 

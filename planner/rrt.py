@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from planner import _kernel as K
-from planner._paths import TURN, advance, pose_at, sample_path
+from planner._paths import TURN, advance, path_buffers, pose_at, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
 from planner._rows import SPACING_M, chord_sag, polyline_clearance
@@ -97,7 +97,7 @@ class Planner:
         cell = min(max(s.eps / 10.0, diag / 400.0), diag / 8.0)
         nx, ny = math.ceil((xmax - xmin) / cell), math.ceil((ymax - ymin) / cell)
         grid = np.array([xmin, ymin, cell, nx, ny], dtype=float)
-        self._tree = K.new_tree(capacity, grid, seed_state(s.seed))
+        self._tree = K.new_tree(capacity, grid, seed_state(s.seed), steering.segments)
         self._tree.cnt[K.BEST] = -1
         P = np.zeros(K.NPARAMS)
         P[K.EPS], P[K.GAMMA], P[K.GOAL_BIAS] = s.eps, s.gamma, s.goal_bias
@@ -114,8 +114,7 @@ class Planner:
         P[K.METRIC] = METRICS.index(s.metric)
         P[K.POLISH] = float(s.polish)
         self._P = P
-        zero = np.zeros(5)
-        K.add_node(self._tree, P, *problem.start, 0.0, -1, zero.astype(np.int8), zero)
+        K.add_node(self._tree, P, *problem.start, 0.0, -1, *path_buffers(steering.segments))
         self._no_events = _event_buffers(0, 0, 0, 0)
         self._events = self._no_events  # the listeners' buffers, grown as needed, reused
         self._listeners: list[Callable[[TreeEvents], None]] = []
@@ -183,20 +182,22 @@ class Planner:
         """(count + 1, 2) positions along the local path from ``node``'s parent to it (the root:
         its position repeated), for drawing curved edges; live, like `poses`."""
         t = self._tree
-        return edge_points(t.pose, t.parent, t.kinds, t.lens, self.problem.rho, node, count)
+        return edge_points(t.pose, t.parent, t.kinds, t.lens, t.curv, node, count)
 
-    def edge_segments(self, node: int) -> tuple[np.ndarray, np.ndarray]:
-        """The local path from ``node``'s parent to it in segment form: kinds and signed
-        lengths (`planner.path_word` names it, `planner.path_length` measures it); copies, of
-        the live tree, so read on the planner's thread like `poses`."""
-        return self._tree.kinds[node].copy(), self._tree.lens[node].copy()
+    def edge_segments(self, node: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The local path from ``node``'s parent to it in segment form: kinds, signed lengths
+        and curvatures (`planner.path_word` names it, `planner.path_length` measures it);
+        copies, of the live tree, so read on the planner's thread like `poses`."""
+        t = self._tree
+        return t.kinds[node].copy(), t.lens[node].copy(), t.curv[node].copy()
 
     def steer_points(self, a, b, count: int = 4) -> np.ndarray:
         """(count + 1, 2) positions along this planner's steering from pose a to pose b: a
         motion the tree does not hold, such as a Steer that an obstacle blocked."""
-        kinds, lens = np.zeros(5, np.int8), np.zeros(5)
-        steer_path(STEERINGS[self.options.steering].code, *a, *b, self.problem.rho, kinds, lens)
-        return path_points(a, kinds, lens, self.problem.rho, count)
+        steering = STEERINGS[self.options.steering]
+        path = path_buffers(steering.segments)
+        steer_path(steering.code, *a, *b, self.problem.rho, *path)
+        return path_points(a, *path, count)
 
     @property
     def finished(self) -> bool:
@@ -207,7 +208,7 @@ class Planner:
         """A copy of the tree, for reading anywhere."""
         n, t = self.nodes, self._tree
         return TreeSnapshot(t.pose[:n].copy(), t.parent[:n].copy(), t.cost[:n].copy(),
-                            t.kinds[:n].copy(), t.lens[:n].copy(), self.problem.rho,
+                            t.kinds[:n].copy(), t.lens[:n].copy(), t.curv[:n].copy(),
                             int(t.cnt[K.BEST]))
 
     # -- running -----------------------------------------------------------------------------
@@ -322,35 +323,36 @@ class Planner:
         parts = [np.array([[*t.pose[chain[0]], 0.0, 1.0]])]
         for node in chain[1:]:
             par = t.parent[node]
-            seg = sample_path(*t.pose[par], t.kinds[node], t.lens[node], self.problem.rho,
-                              spacing)
+            seg = sample_path(*t.pose[par], t.kinds[node], t.lens[node], t.curv[node], spacing)
             parts.append(seg[1:])
         pts = np.vstack(parts)
         driven = np.concatenate([[0.0], np.cumsum(_step_lengths(pts))])
         return np.column_stack([pts, driven / self.options.speed])
 
-    def best_path_segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """The best path as its driven segments: start poses (m, 3), kinds, signed lengths and
-        the driven length where each starts (a turn on the spot is folded into the pose that
-        follows it)."""
-        t, rho = self._tree, self.problem.rho
-        poses, kinds, lens, starts = [], [], [], []
+    def best_path_segments(self) -> tuple[np.ndarray, ...]:
+        """The best path as its driven segments: start poses (m, 3), kinds, signed lengths,
+        curvatures (m, 2) (`planner._paths`) and the driven length where each starts (a turn on
+        the spot is folded into the pose that follows it)."""
+        t = self._tree
+        poses, kinds, lens, curv, starts = [], [], [], [], []
         driven = 0.0
         for node in self.best_path_nodes()[1:]:
             x, y, th = t.pose[t.parent[node]]
-            for kind, seg in zip(t.kinds[node], t.lens[node]):
+            for kind, seg, (k0, sigma) in zip(t.kinds[node], t.lens[node], t.curv[node]):
                 if seg != 0.0 and kind != TURN:
                     poses.append((x, y, th))
                     kinds.append(kind)
                     lens.append(seg)
+                    curv.append((k0, sigma))
                     starts.append(driven)
                     driven += abs(seg)
                 if seg != 0.0:
-                    x, y, th = advance(x, y, th, kind, seg, rho)
+                    x, y, th = advance(x, y, th, kind, seg, k0, sigma)
         if not poses:  # the start is in the goal region
-            poses, kinds, lens, starts = [self.root], [0], [0.0], [0.0]
+            poses, kinds, lens, curv, starts = [self.root], [0], [0.0], [(0.0, 0.0)], [0.0]
         return (np.array(poses, dtype=float), np.array(kinds, dtype=np.int64),
-                np.array(lens, dtype=float), np.array(starts, dtype=float))
+                np.array(lens, dtype=float), np.array(curv, dtype=float),
+                np.array(starts, dtype=float))
 
     @property
     def root(self) -> tuple[float, float, float]:
@@ -370,7 +372,7 @@ class Planner:
         skip = s - t.cost[parent]
         if skip <= 1e-12:
             return self._pose(parent), parent, 0.0
-        x, y, th, _, _ = pose_at(*t.pose[parent], t.kinds[node], t.lens[node], self.problem.rho,
+        x, y, th, _, _ = pose_at(*t.pose[parent], t.kinds[node], t.lens[node], t.curv[node],
                                  skip)
         return (x, y, th), node, float(skip)
 

@@ -3,7 +3,8 @@
 Every edge of the system takes its list from `STEERINGS`: the options model (`PlanOptions`),
 `trackstar plan --steering`, the REST schema, the studio's dropdown and docs. The compiled
 implementations live one per module (`_dubins.py`, `_reeds_shepp.py`, `_straight.py`); the
-planner's kernel reaches them through `_steer.py` by each entry's integer ``code``. Adding a
+planner's kernel reaches them through `_steer.py` by each entry's integer ``code``, and stores
+their paths in the segment form of `_paths.py`, ``segments`` wide. Adding a
 steering function is: its module, an entry here, a branch per function in `_steer.py`.
 """
 
@@ -27,7 +28,8 @@ class Steering:
     ``curved``: it drives arcs of curvature up to 1/ρ, so the chords between a path's rows stray
     from it (`planner._rows.chord_sag`). ``curvature``: what its paths' curvature profile looks
     like (the studio's caption). ``ompl_space``: OMPL's state space of the same paths (None: OMPL
-    has none).
+    has none). ``segments``: the most segments one of its paths has (the width of its paths'
+    arrays in the segment form of `planner._paths`).
     """
 
     name: str
@@ -39,6 +41,7 @@ class Steering:
     curvature: str
     ompl_space: str | None = None
     curved: bool = True
+    segments: int = 5  # Reeds-Shepp's longest words (C|C(π/2)SC(π/2)|C) have five
 
 
 STEERINGS = {s.name: s for s in (

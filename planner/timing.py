@@ -83,8 +83,7 @@ class Schedule:
         i = np.minimum((s_rows / ds).astype(np.int64), n - 1)
         rows, arcs = [_with_times(dense, leave[i] + (s_rows - i * ds) / self.vmax)], [s_rows]
         for k in np.flatnonzero(waits):
-            x, y, th = pose_on(*self.planner.best_path_segments(), self.planner.problem.rho,
-                               k * ds)
+            x, y, th = pose_on(*self.planner.best_path_segments(), k * ds)
             j = min(int(np.searchsorted(s_rows, k * ds)), len(dense) - 1)
             instants = np.linspace(arrive[k], leave[k], math.ceil(waits[k] * dt / MAX_STEP_S) + 1)
             wait = np.tile([x, y, th, dense[j, 3], dense[j, 4], 0.0], (len(instants), 1))
@@ -118,8 +117,8 @@ def fastest_schedule(planner: Planner, world, vmax: float,
     ds = length / n
     dt = ds / vmax
     waits = np.zeros(n + 1, np.int64)
-    arrival = earliest_arrival(world, *planner.best_path_segments(), planner.problem.rho, n, ds,
-                               dt, math.ceil(horizon / dt), waits)
+    arrival = earliest_arrival(world, *planner.best_path_segments(), n, ds, dt,
+                               math.ceil(horizon / dt), waits)
     return Schedule(planner, vmax, length, ds, dt, waits) if arrival >= 0 else None
 
 

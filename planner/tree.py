@@ -18,19 +18,19 @@ from planner._paths import path_length, sample_path
 __all__ = ["Rewire", "TreeEvents", "TreeSnapshot", "edge_points", "path_points"]
 
 
-def edge_points(pose, parent, kinds, lens, rho: float, node: int, count: int) -> np.ndarray:
+def edge_points(pose, parent, kinds, lens, curv, node: int, count: int) -> np.ndarray:
     """(count + 1, 2) positions along the local path from ``node``'s parent to it (the root:
     its position repeated), for drawing curved edges."""
     up = int(parent[node])
     if up < 0:
         return np.repeat(pose[node:node + 1, :2], count + 1, axis=0)
-    return path_points(pose[up], kinds[node], lens[node], rho, count)
+    return path_points(pose[up], kinds[node], lens[node], curv[node], count)
 
 
-def path_points(start, kinds, lens, rho: float, count: int) -> np.ndarray:
+def path_points(start, kinds, lens, curv, count: int) -> np.ndarray:
     """(count + 1, 2) positions, evenly spread, along a local path from pose ``start``."""
     total = path_length(kinds, lens)
-    dense = sample_path(*start, kinds, lens, rho, max(total / (4 * count), 1e-6))
+    dense = sample_path(*start, kinds, lens, curv, max(total / (4 * count), 1e-6))
     pick = np.linspace(0, len(dense) - 1, count + 1).round().astype(int)
     return dense[pick, :2]
 
@@ -39,14 +39,14 @@ def path_points(start, kinds, lens, rho: float, count: int) -> np.ndarray:
 class TreeSnapshot:
     """A copy of the tree: node i has ``pose[i]`` (x, y, θ), ``parent[i]`` (-1: the root),
     ``cost[i]`` (driven length from the root) and reaches it by the local path (``kinds[i]``,
-    ``lens[i]``) in the segment form of `planner._paths`."""
+    ``lens[i]``, ``curv[i]``) in the segment form of `planner._paths`."""
 
     pose: np.ndarray
     parent: np.ndarray
     cost: np.ndarray
     kinds: np.ndarray
     lens: np.ndarray
-    rho: float
+    curv: np.ndarray
     best_node: int  # -1 before a solution
 
     @property
@@ -60,7 +60,7 @@ class TreeSnapshot:
 
     def edge_points(self, node: int, count: int = 4) -> np.ndarray:
         """(count + 1, 2) positions along the edge into ``node`` (see `edge_points`)."""
-        return edge_points(self.pose, self.parent, self.kinds, self.lens, self.rho, node, count)
+        return edge_points(self.pose, self.parent, self.kinds, self.lens, self.curv, node, count)
 
 
 class Rewire(NamedTuple):

@@ -7,6 +7,7 @@ import pytest
 from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
+from _arcs import arcs
 from planner._dubins import (dubins_length, dubins_lower_bound_cs, dubins_path,
                              dubins_word_bound, turning_centres)
 from planner._paths import path_end, path_length, sample_path
@@ -49,7 +50,7 @@ def test_exact_endpoint_and_length(q0, q1):
     assume(q0 == q1 or math.hypot(q1[0] - q0[0], q1[1] - q0[1]) > 1e-6
            or abs(math.remainder(q1[2] - q0[2], 2 * math.pi)) > 1e-6)
     length, kinds, lens = shortest(q0, q1)
-    end = path_end(*q0, kinds, lens, RHO)
+    end = path_end(*q0, kinds, lens, arcs(kinds, RHO))
     assert end[:2] == pytest.approx(q1[:2], abs=1e-9)
     assert math.remainder(end[2] - q1[2], 2 * math.pi) == pytest.approx(0.0, abs=1e-9)
     assert path_length(kinds, lens) == pytest.approx(length, abs=1e-12)
@@ -163,6 +164,6 @@ def test_word_bound_sees_the_loops_the_turning_circles_miss(q1):
 @given(pose, pose)
 def test_samples_have_curvature_zero_or_one_over_rho(q0, q1):
     _, kinds, lens = shortest(q0, q1)
-    pts = sample_path(*q0, kinds, lens, RHO, 0.02)
+    pts = sample_path(*q0, kinds, lens, arcs(kinds, RHO), 0.02)
     assert set(np.round(np.abs(pts[:, 3]) * RHO, 12)) <= {0.0, 1.0}
     assert np.all(np.hypot(*np.diff(pts[:, :2], axis=0).T) <= 0.02 + 1e-9)

@@ -7,7 +7,16 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from planner._paths import MIN_SEGMENT, path_end, path_length, path_word, pose_at, sample_path
+from _arcs import arcs
+from planner._paths import (
+    MIN_SEGMENT,
+    path_buffers,
+    path_end,
+    path_length,
+    path_word,
+    pose_at,
+    sample_path,
+)
 
 lengths = st.floats(-5, 5, allow_nan=False)
 kinds_st = st.lists(st.sampled_from([-1, 0, 1]), min_size=5, max_size=5)
@@ -16,7 +25,7 @@ kinds_st = st.lists(st.sampled_from([-1, 0, 1]), min_size=5, max_size=5)
 def test_quarter_circle_left_ends_where_geometry_says():
     kinds = np.array([1, 0, 0, 0, 0], dtype=np.int8)
     lens = np.array([math.pi / 2, 0, 0, 0, 0])
-    x, y, th = path_end(0.0, 0.0, 0.0, kinds, lens, 1.0)
+    x, y, th = path_end(0.0, 0.0, 0.0, kinds, lens, arcs(kinds, 1.0))
     assert (x, y, th) == pytest.approx((1.0, 1.0, math.pi / 2), abs=1e-12)
 
 
@@ -25,12 +34,13 @@ def test_quarter_circle_left_ends_where_geometry_says():
 def test_samples_are_continuous_and_end_at_the_end(kinds, lens, rho):
     kinds = np.array(kinds, dtype=np.int8)
     lens = np.array(lens)
-    pts = sample_path(0.5, -0.2, 0.3, kinds, lens, rho, 0.02)
-    end = path_end(0.5, -0.2, 0.3, kinds, lens, rho)
+    curv = arcs(kinds, rho)
+    pts = sample_path(0.5, -0.2, 0.3, kinds, lens, curv, 0.02)
+    end = path_end(0.5, -0.2, 0.3, kinds, lens, curv)
     assert np.allclose(pts[-1, :3], end, atol=1e-9)
     # A segment under MIN_SEGMENT has no row: the step over it is that much longer.
     assert np.all(np.hypot(*np.diff(pts[:, :2], axis=0).T) <= 0.02 + 6 * MIN_SEGMENT)
-    mid = pose_at(0.5, -0.2, 0.3, kinds, lens, rho, path_length(kinds, lens))
+    mid = pose_at(0.5, -0.2, 0.3, kinds, lens, curv, path_length(kinds, lens))
     assert np.allclose(mid[:3], end, atol=1e-9)
 
 
@@ -38,8 +48,8 @@ def _word(steering: str, goal, rho: float = 1.0) -> str:
     from planner._steer import steer_path
     from planner.steering import STEERINGS
 
-    kinds, lens = np.zeros(5, np.int8), np.zeros(5)
-    steer_path(STEERINGS[steering].code, 0.0, 0.0, 0.0, *map(float, goal), rho, kinds, lens)
+    kinds, lens, curv = path_buffers(STEERINGS[steering].segments)
+    steer_path(STEERINGS[steering].code, 0.0, 0.0, 0.0, *map(float, goal), rho, kinds, lens, curv)
     return path_word(kinds, lens)
 
 
@@ -80,5 +90,5 @@ def test_the_word_names_the_segments_a_path_samples(kinds, lens):
     letters = [c for c in word if c in "LSR"]
     assert letters == ["LSR"[1 - k] for k, v in zip(kinds, lens) if abs(v) > MIN_SEGMENT]
     signs = [c for c in word if c in "+−"]
-    rows = sample_path(0.0, 0.0, 0.0, kinds, lens, 1.0, 10.0)[1:, 4]  # a row per segment
+    rows = sample_path(0.0, 0.0, 0.0, kinds, lens, arcs(kinds, 1.0), 10.0)[1:, 4]  # a row per segment
     assert signs == ([] if (rows > 0).all() else ["+" if d > 0 else "−" for d in rows])

@@ -172,6 +172,7 @@ def test_nearest_is_the_true_nearest_by_steering_length(name, steering):
     """The pruned best-first search returns what a scan of every node returns (OMPL's way)."""
     from planner import Planner, PlanOptions
     from planner import _kernel as K
+    from planner._paths import path_buffers
     from planner._steer import steer_path
 
     problem = planner.compile_problem(planner.parse_scenario(scenario_dict(name)))
@@ -179,13 +180,13 @@ def test_nearest_is_the_true_nearest_by_steering_length(name, steering):
     run.step(3000)
     tree, n = run._tree, run.nodes
     code = planner.STEERINGS[steering].code
-    kinds, lens = np.zeros(5, np.int8), np.zeros(5)
+    path = path_buffers(planner.STEERINGS[steering].segments)
     rng = np.random.default_rng(0)
     xmin, ymin, xmax, ymax = problem.bounds
     for _ in range(150):
         q = (rng.uniform(xmin, xmax), rng.uniform(ymin, ymax), rng.uniform(-math.pi, math.pi))
         node, found = K.nearest(tree, run._P, *q)
-        lengths = [steer_path(code, *tree.pose[j], *q, problem.rho, kinds, lens)
+        lengths = [steer_path(code, *tree.pose[j], *q, problem.rho, *path)
                    for j in range(n)]
         assert found == pytest.approx(min(lengths), abs=1e-9)
         assert lengths[node] == pytest.approx(found, abs=1e-9)

@@ -15,6 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from _arcs import arcs
 from planner._paths import path_end, sample_path
 from planner._reeds_shepp import reeds_shepp_length, reeds_shepp_path
 
@@ -66,7 +67,7 @@ def transform(p, dx, dy, rot):
 @given(pose, pose, radius)
 def test_word_reaches_the_goal_exactly(p, q, rho):
     total, kinds, lens = solve(p, q, rho)
-    x, y, th = path_end(*p, kinds, lens, rho)
+    x, y, th = path_end(*p, kinds, lens, arcs(kinds, rho))
     assert abs(x - q[0]) <= 1e-9 and abs(y - q[1]) <= 1e-9
     assert angle_diff(th, q[2]) <= 1e-9
     assert total == pytest.approx(np.abs(lens).sum(), rel=1e-12, abs=1e-12)
@@ -79,7 +80,7 @@ def test_word_reaches_the_goal_exactly(p, q, rho):
 @given(pose, pose, radius)
 def test_samples_are_continuous_with_car_curvatures(p, q, rho):
     _, kinds, lens = solve(p, q, rho)
-    pts = sample_path(*p, kinds, lens, rho, 0.02)
+    pts = sample_path(*p, kinds, lens, arcs(kinds, rho), 0.02)
     assert np.all(np.hypot(*np.diff(pts[:, :2], axis=0).T) <= 0.02 + 1e-9)
     curv = pts[:, 3]
     assert np.all(np.isclose(curv, 0.0) | np.isclose(np.abs(curv), 1.0 / rho))
@@ -149,19 +150,19 @@ same_turn = st.lists(st.floats(0, math.pi / 5), min_size=1, max_size=5)
 
 @settings(max_examples=150, deadline=None)
 @given(same_turn, st.sampled_from([1, -1]), st.booleans(), radius)
-def test_cusped_paths_that_turn_one_way_are_optimal(arcs, side, backwards_first, rho):
+def test_cusped_paths_that_turn_one_way_are_optimal(angles, side, backwards_first, rho):
     """Arcs that all turn the heading the same way (L+, R-, L+, ... with cusps) and add up to
     at most π have length ρ·|Δθ|, the heading lower bound, so they are exactly optimal."""
     kinds = np.zeros(5, dtype=np.int8)
     lens = np.zeros(5)
     sign = -1.0 if backwards_first else 1.0
-    for i, a in enumerate(arcs):
+    for i, a in enumerate(angles):
         kinds[i] = side * (1 if sign > 0 else -1)
         lens[i] = sign * rho * a
         sign = -sign
     start = (0.3, -0.4, 0.7)
-    goal = path_end(*start, kinds, lens, rho)
-    assert length(start, goal, rho) == pytest.approx(rho * sum(arcs), abs=tol(rho))
+    goal = path_end(*start, kinds, lens, arcs(kinds, rho))
+    assert length(start, goal, rho) == pytest.approx(rho * sum(angles), abs=tol(rho))
 
 
 # ---- metric properties --------------------------------------------------------------------
@@ -200,7 +201,7 @@ def test_no_random_word_is_shorter(kinds, lens, rho, start):
     """Any drive of at most five segments is a feasible path, so it bounds RS from above."""
     kinds = np.array(kinds, dtype=np.int8)
     lens = np.array(lens)
-    goal = path_end(*start, kinds, lens, rho)
+    goal = path_end(*start, kinds, lens, arcs(kinds, rho))
     assert length(start, goal, rho) <= np.abs(lens).sum() + tol(rho)
 
 
@@ -306,5 +307,5 @@ def test_a_vanishing_last_arc_is_not_lost_to_rounding():
     OMPL's slack of 10 machine epsilons refused, and a word 5 % longer won (hypothesis)."""
     start, rho = (1.0, 0.0, 0.0), 3.0
     kinds, lens = np.array([-1, 0, 0, 0, 0], np.int8), np.array([-1.5, -0.05078125, 0, 0, 0])
-    goal = path_end(*start, kinds, lens, rho)
+    goal = path_end(*start, kinds, lens, arcs(kinds, rho))
     assert length(start, goal, rho) == pytest.approx(1.55078125, abs=1e-9)

@@ -15,7 +15,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from planner import STEERINGS, PlanOptions
-from planner._paths import path_end, path_length, pose_at, sample_path
+from planner._paths import path_buffers, path_end, path_length, pose_at, sample_path
 from planner._steer import state, steer_bound, steer_length, steer_path, steer_tight_bound
 
 RHO = 0.9
@@ -26,9 +26,11 @@ steerings = pytest.mark.parametrize("steering", list(STEERINGS.values()), ids=li
 
 
 def shortest(code, q0, q1):
-    kinds, lens = np.zeros(5, np.int8), np.zeros(5)
-    length = steer_path(code, *q0, *q1, RHO, kinds, lens)
-    return length, kinds, lens
+    """(length, kinds, lens, curv) of the shortest path from q0 to q1."""
+    steering = next(s for s in STEERINGS.values() if s.code == code)
+    path = path_buffers(steering.segments)
+    length = steer_path(code, *q0, *q1, RHO, *path)
+    return (length, *path)
 
 
 def as_state(q):
@@ -46,8 +48,8 @@ def distinct(q0, q1):
 @given(q0=pose, q1=pose)
 def test_paths_end_exactly_and_their_length_is_the_segments(steering, q0, q1):
     assume(distinct(q0, q1))
-    length, kinds, lens = shortest(steering.code, q0, q1)
-    end = path_end(*q0, kinds, lens, RHO)
+    length, kinds, lens, curv = shortest(steering.code, q0, q1)
+    end = path_end(*q0, kinds, lens, curv)
     assert end[:2] == pytest.approx(q1[:2], abs=1e-9)
     assert math.remainder(end[2] - q1[2], 2 * math.pi) == pytest.approx(0.0, abs=1e-9)
     assert path_length(kinds, lens) == pytest.approx(length, abs=1e-9)
@@ -103,8 +105,8 @@ def test_symmetric_where_the_robot_may_go_back_and_under_flipped_headings(steeri
 @given(q0=pose, q1=pose)
 def test_straight_rows_carry_the_direction_of_travel_and_no_curvature(q0, q1):
     assume(math.hypot(q1[0] - q0[0], q1[1] - q0[1]) > 1e-3)
-    _, kinds, lens = shortest(STEERINGS["straight"].code, q0, q1)
-    rows = sample_path(*q0, kinds, lens, RHO, 0.05)
+    _, kinds, lens, curv = shortest(STEERINGS["straight"].code, q0, q1)
+    rows = sample_path(*q0, kinds, lens, curv, 0.05)
     travel = math.atan2(q1[1] - q0[1], q1[0] - q0[0])
     moving = np.hypot(*np.diff(rows[:, :2], axis=0).T) > 1e-9
     headings = rows[1:][moving, 2]
@@ -112,9 +114,9 @@ def test_straight_rows_carry_the_direction_of_travel_and_no_curvature(q0, q1):
     assert np.all(rows[:, 3] == 0.0) and np.all(rows[:, 4] == 1.0)
     assert rows[-1, :2] == pytest.approx(q1[:2], abs=1e-9)
     # halfway along, the robot faces its way; at the start it has not turned yet
-    half = pose_at(*q0, kinds, lens, RHO, 0.5 * path_length(kinds, lens))
+    half = pose_at(*q0, kinds, lens, curv, 0.5 * path_length(kinds, lens))
     assert math.cos(half[2] - travel) == pytest.approx(1.0)
-    assert pose_at(*q0, kinds, lens, RHO, 0.0)[2] == q0[2]
+    assert pose_at(*q0, kinds, lens, curv, 0.0)[2] == q0[2]
 
 
 def test_the_registry_is_what_the_options_accept():

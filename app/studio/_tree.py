@@ -59,8 +59,8 @@ class EdgeChunks:
         self.old_seg, self.old_pieces = min(old_seg, seg), old_pieces
         self._drawn: dict[int, tuple[int, int]] = {}  # chunk: the level it was sent with
         self._pts = np.zeros((capacity, seg + 1, 2), np.float32)
-        self._kinds = np.zeros((capacity, 5), np.int8)
-        self._lens = np.zeros((capacity, 5))
+        self._kinds = np.zeros((capacity, 0), np.int8)  # as wide as the steering's paths
+        self._lens = np.zeros((capacity, 0))
         self._n = 0
         self._tail_dirty = False
         self._sent_n = 0  # nodes the browser had at the last tail push
@@ -84,8 +84,8 @@ class EdgeChunks:
         """Hold exactly these edges, (count, seg + 1, 2), node i's at i (a replayed tree)."""
         with self._lock:
             self._pts = np.array(pts, np.float32)
-            self._kinds = np.zeros((len(pts), 5), np.int8)
-            self._lens = np.zeros((len(pts), 5))
+            self._kinds = np.zeros((len(pts), 0), np.int8)
+            self._lens = np.zeros((len(pts), 0))
             self._n = len(pts)
 
     @property
@@ -109,6 +109,9 @@ class EdgeChunks:
                     for a in (self._pts, self._kinds, self._lens))
             self._pts[node] = pts
             if kinds is not None:
+                if len(kinds) != self._kinds.shape[1]:  # the first edge: the run's width
+                    self._kinds = np.zeros((len(self._pts), len(kinds)), np.int8)
+                    self._lens = np.zeros((len(self._pts), len(kinds)))
                 self._kinds[node], self._lens[node] = kinds, lens
             self._n = max(self._n, node + 1)
             c = node // self.chunk

@@ -161,7 +161,8 @@ class Lane:
     def _record(self, node: int) -> np.ndarray:
         """Node's edge as drawn and as a click names it (its segments); returns its points."""
         pts = self.tree.edge_points(node, SEG)
-        self.live.chunks.set(node, pts, *self.tree.edge_segments(node))
+        kinds, lens, _ = self.tree.edge_segments(node)
+        self.live.chunks.set(node, pts, kinds, lens)
         return pts
 
     def _note_step(self, ev: planner.TreeEvents, rewired: list) -> None:

@@ -260,5 +260,5 @@ def warm_up() -> None:
     old = Planner(problem, PlanOptions())
     old.step(40)
     Planner(problem, PlanOptions()).adopt(old, 0, 0.0)
-    pose_at(0.0, 0.0, 0.0, np.zeros(5, np.int8), np.full(5, 0.2), 1.0, 0.1)
+    pose_at(0.0, 0.0, 0.0, np.zeros(5, np.int8), np.full(5, 0.2), np.zeros((5, 2)), 0.1)
     _warm = True
