@@ -16,6 +16,7 @@ from planner._paths import (
     path_word,
     pose_at,
     sample_path,
+    truncate,
 )
 
 lengths = st.floats(-5, 5, allow_nan=False)
@@ -92,3 +93,40 @@ def test_the_word_names_the_segments_a_path_samples(kinds, lens):
     signs = [c for c in word if c in "+−"]
     rows = sample_path(0.0, 0.0, 0.0, kinds, lens, arcs(kinds, 1.0), 10.0)[1:, 4]  # a row per segment
     assert signs == ([] if (rows > 0).all() else ["+" if d > 0 else "−" for d in rows])
+
+
+def cc_turn(kappa: float, sigma: float, arc: float, direction: float = 1.0):
+    """A continuous-curvature left turn in the segment form: a clothoid from κ = 0 up to
+    ``kappa`` at sharpness σ, an arc of ``arc`` metres, a clothoid back down to 0."""
+    ramp = kappa / sigma
+    kinds = np.array([1, 1, 1, 0, 0], np.int8)
+    lens = direction * np.array([ramp, arc, ramp, 0.0, 0.0])
+    curv = np.array([[0.0, sigma], [kappa, 0.0], [kappa, -sigma], [0.0, 0.0], [0.0, 0.0]])
+    return kinds, lens, curv
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.floats(0.2, 2.5), st.floats(0.5, 20.0), st.floats(0.0, 3.0), st.sampled_from([1.0, -1.0]),
+       st.floats(0.0, 1.0))
+def test_a_clothoid_turn_samples_with_curvature_ramps_and_cuts_where_it_is_driven(
+        kappa, sigma, arc, direction, share):
+    """Rows of a CC turn change curvature by at most σ × their spacing, never jump; they are
+    continuous and end at the path's end; the pose a share of the way along is the end of the
+    path cut there, and it turns the heading by exactly the area under κ."""
+    kinds, lens, curv = cc_turn(kappa, sigma, arc, direction)
+    spacing = 0.02
+    rows = sample_path(0.3, -0.1, 0.4, kinds, lens, curv, spacing)
+    steps = np.hypot(*np.diff(rows[:, :2], axis=0).T)
+    assert steps.max() <= spacing + 1e-9
+    assert np.abs(np.diff(rows[:, 3])).max() <= sigma * spacing + 1e-9
+    assert rows[0, 3] == 0.0 and rows[-1, 3] == pytest.approx(0.0, abs=1e-9)
+    assert rows[:, 3].max() == pytest.approx(kappa)
+    assert np.all(rows[:, 4] == direction)
+    end = path_end(0.3, -0.1, 0.4, kinds, lens, curv)
+    assert rows[-1, :3] == pytest.approx(end, abs=1e-9)
+    total = path_length(kinds, lens)
+    assert end[2] - 0.4 == pytest.approx(direction * kappa * (kappa / sigma + arc), abs=1e-9)
+    cut = np.zeros(5)
+    truncate(kinds, lens, share * total, cut)
+    assert pose_at(0.3, -0.1, 0.4, kinds, lens, curv, share * total)[:3] == pytest.approx(
+        path_end(0.3, -0.1, 0.4, kinds, cut, curv), abs=1e-9)
