@@ -2,6 +2,10 @@
 
     python benchmarks/bench_planner.py        # 5 static scenarios, budgets 0.1 s and 1 s, seeds 0-4
 
+Ours also runs with continuous-curvature steering (--steerings, default dubins and cc-dubins):
+OMPL has no CC space, so CC-Dubins is measured against our Dubins rate and OMPL RRT*'s Dubins
+rate (the CC path is the harder problem, so that ratio is conservative).
+
 "Best known" costs come from benchmarks/results/best_known.json; a scenario missing there is first
 run for --long-s seconds (default 20) with seeds 0-2 by ours and, with OMPL, by BIT*, and the
 lowest cost any of them reached is stored with how it was found.
@@ -46,6 +50,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--seeds", nargs="+", type=int, default=list(range(5)))
     parser.add_argument("--budgets", nargs="+", type=float, default=[0.1, 1.0], metavar="SECONDS")
     parser.add_argument("--only", choices=[OURS, "ompl"], help="run only our planner or only OMPL")
+    parser.add_argument("--steerings", nargs="+", default=["dubins", "cc-dubins"],
+                        metavar="NAME", help="our steerings to run (OMPL's is Dubins)")
     parser.add_argument("--json", type=Path, metavar="OUT", help="also write every run's record")
     parser.add_argument("--ompl-from", type=Path, metavar="RECORDS",
                         help="take OMPL's runs from an earlier --json instead of running OMPL "
@@ -102,25 +108,35 @@ def _our_planner():
     return planner
 
 
+def our_label(steering: str) -> str:
+    """Ours with Dubins is "ours", as OMPL's rows are Dubins; another steering is named."""
+    return OURS if steering == "dubins" else f"{OURS} {steering}"
+
+
 def our_runs(trackstar, paths: dict[str, Path], seeds: list[int], budgets: list[float],
-             bar: tqdm) -> list[dict]:
-    """One run of ours per (scenario, seed) at the largest budget, reported at every budget."""
+             steerings: list[str], bar: tqdm) -> list[dict]:
+    """One run of ours per (scenario, steering, seed) at the largest budget, reported at every
+    budget."""
     records = []
     for name, path in paths.items():
         scenario = trackstar.load_scenario(path)
-        trackstar.solve(scenario, planner="rrtstar", steering="dubins", time_limit=0.05, seed=0)
-        for seed in seeds:
-            bar.set_postfix_str(f"{name} ours seed {seed}")
-            start = time.perf_counter()
-            result = trackstar.solve(scenario, planner="rrtstar", steering="dubins",
-                                     time_limit=budgets[-1], seed=seed)
-            setup_s = time.perf_counter() - start - result.planning_time_s
-            records += [_our_record(result, name, seed, budget, setup_s) for budget in budgets]
-            bar.update()
+        for steering in steerings:
+            trackstar.solve(scenario, planner="rrtstar", steering=steering, time_limit=0.05,
+                            seed=0)
+            for seed in seeds:
+                bar.set_postfix_str(f"{name} {our_label(steering)} seed {seed}")
+                start = time.perf_counter()
+                result = trackstar.solve(scenario, planner="rrtstar", steering=steering,
+                                         time_limit=budgets[-1], seed=seed)
+                setup_s = time.perf_counter() - start - result.planning_time_s
+                records += [_our_record(result, name, our_label(steering), seed, budget,
+                                        setup_s) for budget in budgets]
+                bar.update()
     return records
 
 
-def _our_record(result, scenario: str, seed: int, budget: float, setup_s: float) -> dict:
+def _our_record(result, scenario: str, label: str, seed: int, budget: float,
+                setup_s: float) -> dict:
     """Our result as it stood at `budget`, in the record format of ompl_baseline.run_ompl.
 
     Iterations per second of planning, as for OMPL, whose problem set-up is not timed either;
@@ -129,7 +145,7 @@ def _our_record(result, scenario: str, seed: int, budget: float, setup_s: float)
     costs = [cost for t, cost, _ in result.cost_over_time if t <= budget]
     return {
         "scenario": scenario,
-        "planner": OURS,
+        "planner": label,
         "time_limit_s": budget,
         "seed": seed,
         "solved": bool(costs),
@@ -205,7 +221,8 @@ def summarise(records: list[dict], budgets: list[float]) -> dict[tuple[str, str]
             "runs": len(longest),
             "iterations_per_s": _median([r["iterations_per_s"] for r in longest]),
             "ttfs_s": _median([r["time_to_first_solution_s"] for r in solved]),
-            "valid_5mm": sum(bool(r["valid_5mm"]) for r in solved) if key[1] != OURS else None,
+            "valid_5mm": (sum(bool(r["valid_5mm"]) for r in solved)
+                          if key[1] in OMPL_PLANNERS else None),
             "solved": len(solved),
             "budgets": {b: _budget_summary([r for r in runs if r["time_limit_s"] == b])
                         for b in budgets},
@@ -231,8 +248,9 @@ def results_table(summary: dict, scenarios: list[str], budgets: list[float]) -> 
     budget_cols = " | ".join(f"cost {b:g} s (solved)" for b in budgets)
     lines = [f"| scenario | planner | it/s | first solution ms | {budget_cols} | valid at 5 mm |",
              "|---|---|---:|---:|" + "---:|" * len(budgets) + "---:|"]
+    ours = sorted({p for _, p in summary if p not in OMPL_PLANNERS})
     for scenario in scenarios:
-        for planner in [*OMPL_PLANNERS, OURS]:
+        for planner in [*OMPL_PLANNERS, *ours]:
             row = summary.get((scenario, planner))
             if row is None:
                 continue
@@ -257,6 +275,23 @@ def ratios_table(summary: dict, scenarios: list[str], budgets: list[float]) -> s
         speed = _ratio(ours["iterations_per_s"], rrtstar["iterations_per_s"])
         lines.append(f"| {scenario} | {speed} | {_ratio(ours['ttfs_s'], rrtstar['ttfs_s'])} | "
                      f"{_ratio(ours['budgets'][budgets[-1]][0], best_cost)} ({best}) |")
+    return "\n".join(lines)
+
+
+def steering_table(summary: dict, scenarios: list[str], steering: str) -> str:
+    """Markdown table of our rate with ``steering`` against ours with Dubins and OMPL RRT*'s."""
+    label = our_label(steering)
+    lines = [f"| scenario | it/s {steering} | / ours Dubins | / OMPL RRT* Dubins |",
+             "|---|---:|---:|---:|"]
+    for scenario in scenarios:
+        row = summary.get((scenario, label))
+        if row is None:
+            continue
+        dubins, rrtstar = summary.get((scenario, OURS)), summary.get((scenario, "RRTstar"))
+        rate = row["iterations_per_s"]
+        lines.append(f"| {scenario} | {_fmt(rate, '.0f')} | "
+                     f"{_ratio(rate, dubins and dubins['iterations_per_s'])} | "
+                     f"{_ratio(rate, rrtstar and rrtstar['iterations_per_s'])} |")
     return "\n".join(lines)
 
 
@@ -301,6 +336,9 @@ def report(summary: dict, args: argparse.Namespace, command: str, seconds: float
     ]
     if args.only is None:
         parts.append(ratios_table(summary, args.scenarios, args.budgets))
+    for steering in args.steerings:
+        if steering != "dubins" and args.only != "ompl":
+            parts.append(steering_table(summary, args.scenarios, steering))
     if known:
         parts.append(f"Best known: the lowest cost in {BEST_KNOWN.name}, found by long runs "
                      f"(--long-s, seeds {LONG_SEEDS}) of ours and of OMPL BIT*.")
@@ -320,14 +358,14 @@ def main(argv: list[str] | None = None) -> None:
     runs_per_planner = len(paths) * len(args.seeds)
     n_ompl = (0 if args.only == OURS or args.ompl_from
               else runs_per_planner * len(OMPL_PLANNERS) * len(args.budgets))
-    n_ours = 0 if args.only == "ompl" else runs_per_planner
+    n_ours = 0 if args.only == "ompl" else runs_per_planner * len(args.steerings)
 
     ours = _our_planner() if n_ours else None  # fails before the OMPL runs, not after them
     start = time.perf_counter()
     records = ompl_records(args.ompl_from, args) if args.ompl_from else []
     with tqdm(total=n_ompl + n_ours, unit="run") as bar:
         if n_ours:
-            records += our_runs(ours, paths, args.seeds, args.budgets, bar)
+            records += our_runs(ours, paths, args.seeds, args.budgets, args.steerings, bar)
         if n_ompl:
             records += ompl_runs(scenarios, args.seeds, args.budgets, bar)
     options = sys.argv[1:] if argv is None else argv

@@ -21,7 +21,7 @@ _WORDS = np.array(
 
 
 @njit(cache=True, inline="always")
-def _mod2pi(a: float) -> float:
+def mod2pi(a: float) -> float:
     """Wrap to [0, 2π). Branches for the common |a| < 2π: Python's floored ``%`` costs about
     eight times as much, and a Dubins length takes up to 14 of these."""
     if a < 0.0:
@@ -78,7 +78,7 @@ def _shortest_word(dx, dy, c0, s0, c1, s1, bound):
             < best[1] + best[2] + best[3]):
         a, b = _angles(a, b, ca, sa, cb, sb)
         th = math.atan2(cb - ca, d + sa - sb)
-        best = _keep(best, 0, _mod2pi(-a + th), _sqrt0(tmp), _mod2pi(b - th))
+        best = _keep(best, 0, mod2pi(-a + th), _sqrt0(tmp), mod2pi(b - th))
     # RSR: t = α − θ, q = θ − β with θ the direction of (d − sa + sb, ca − cb)
     tmp = (d - sa + sb) ** 2 + (ca - cb) ** 2
     p = _sqrt0(tmp)
@@ -87,7 +87,7 @@ def _shortest_word(dx, dy, c0, s0, c1, s1, bound):
             < best[1] + best[2] + best[3]):
         a, b = _angles(a, b, ca, sa, cb, sb)
         th = math.atan2(ca - cb, d - sa + sb)
-        best = _keep(best, 1, _mod2pi(a - th), _sqrt0(tmp), _mod2pi(-b + th))
+        best = _keep(best, 1, mod2pi(a - th), _sqrt0(tmp), mod2pi(-b + th))
     # RSL: t = α − θ, q = β − θ with θ = angle(d − sa − sb, ca + cb) − angle(p, 2); both
     # vectors have the norm √(p² + 4)
     tmp = (d - sa - sb) ** 2 + (ca + cb) ** 2 - 4.0
@@ -98,7 +98,7 @@ def _shortest_word(dx, dy, c0, s0, c1, s1, bound):
             ca, sa, cb, sb, 1.0, 1.0) < best[1] + best[2] + best[3]:
         a, b = _angles(a, b, ca, sa, cb, sb)
         th = math.atan2(ca + cb, d - sa - sb) - math.atan2(2.0, p)
-        best = _keep(best, 2, _mod2pi(a - th), p, _mod2pi(b - th))
+        best = _keep(best, 2, mod2pi(a - th), p, mod2pi(b - th))
     # LSR: t = θ − α, q = θ − β with θ = angle(d + sa + sb, −ca − cb) − angle(p, −2)
     tmp = (d + sa + sb) ** 2 + (ca + cb) ** 2 - 4.0
     p = _sqrt0(tmp)
@@ -108,7 +108,7 @@ def _shortest_word(dx, dy, c0, s0, c1, s1, bound):
             ca, sa, cb, sb, -1.0, -1.0) < best[1] + best[2] + best[3]:
         a, b = _angles(a, b, ca, sa, cb, sb)
         th = math.atan2(-ca - cb, d + sa + sb) - math.atan2(-2.0, p)
-        best = _keep(best, 3, _mod2pi(-a + th), p, _mod2pi(-b + th))
+        best = _keep(best, 3, mod2pi(-a + th), p, mod2pi(-b + th))
     if best[1] + best[2] + best[3] <= math.pi:
         return best  # CCC words are never shorter than π
     sab = sb * ca - cb * sa  # sin(β − α)
@@ -118,16 +118,16 @@ def _shortest_word(dx, dy, c0, s0, c1, s1, bound):
         a, b = _angles(a, b, ca, sa, cb, sb)
         p = _TWO_PI - math.acos(tmp)
         th = math.atan2(ca - cb, d - sa + sb)
-        t = _mod2pi(a - th + 0.5 * p)
-        best = _keep(best, 4, t, p, _mod2pi(a - b - t + p))
+        t = mod2pi(a - th + 0.5 * p)
+        best = _keep(best, 4, t, p, mod2pi(a - b - t + p))
     # LRL
     tmp = 0.125 * (6.0 - d * d + 2.0 * cab + 2.0 * d * (-sa + sb))
     if abs(tmp) <= 1.0 and _ccc_bound(tmp, cab, -sab) < best[1] + best[2] + best[3]:
         a, b = _angles(a, b, ca, sa, cb, sb)
         p = _TWO_PI - math.acos(tmp)
         th = math.atan2(-ca + cb, d + sa - sb)
-        t = _mod2pi(-a + th + 0.5 * p)
-        best = _keep(best, 5, t, p, _mod2pi(b - a - t + p))
+        t = mod2pi(-a + th + 0.5 * p)
+        best = _keep(best, 5, t, p, mod2pi(b - a - t + p))
     return best
 
 
@@ -135,7 +135,7 @@ def _shortest_word(dx, dy, c0, s0, c1, s1, bound):
 def _arc_bound(c, s) -> float:
     """A lower bound of the angle φ in [0, 2π) with cos φ = c and sin φ = s, without atan2: in
     each quadrant φ exceeds the quadrant's start by at least the sine of the excess. Angles
-    within 1e-9 of 0 or 2π count as 0, as `_mod2pi` rounds them."""
+    within 1e-9 of 0 or 2π count as 0, as `mod2pi` rounds them."""
     if s >= -1e-9:
         return max(s, 0.0) if c >= 0.0 else 0.5 * math.pi - c
     return math.pi - s if c < 0.0 else 1.5 * math.pi + c
@@ -167,8 +167,8 @@ def _ccc_bound(x, cd, sd) -> float:
 def _angles(a, b, ca, sa, cb, sb):
     """α and β in [0, 2π) from their cosines and sines, once (negative means "not yet")."""
     if a < 0.0:
-        a = _mod2pi(math.atan2(sa, ca))
-        b = _mod2pi(math.atan2(sb, cb))
+        a = mod2pi(math.atan2(sa, ca))
+        b = mod2pi(math.atan2(sb, cb))
     return a, b
 
 
@@ -262,7 +262,7 @@ def dubins_word_bound(l0x, l0y, r0x, r0y, c0, s0, l1x, l1y, r1x, r1y, c1, s1, tu
     circles let such a node through at 5 ρ when its path is 7 ρ long.
     """
     tiny = 1e-9 * rho
-    ccw = turn if turn > -1e-9 else turn + _TWO_PI  # LSL's turning, rounded like _mod2pi
+    ccw = turn if turn > -1e-9 else turn + _TWO_PI  # LSL's turning, rounded like mod2pi
     cw = -turn if turn < 1e-9 else _TWO_PI - turn
     vx, vy = l1x - l0x, l1y - l0y
     a = math.sqrt(vx * vx + vy * vy)

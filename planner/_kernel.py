@@ -28,12 +28,14 @@ from planner._dubins import turning_centres
 from planner._goal import in_goal
 from planner._jit import njit
 from planner._paths import path_buffers, path_end, truncate, wrap_angle
+from planner._cc_dubins import cc_constants
 from planner._polish import PASSES, polish_path
 from planner._rng import uniform
 from planner._steer import (
     arrival_heading,
     state,
     steer_bound,
+    steer_cut,
     steer_length,
     steer_path,
     steer_tight_bound,
@@ -41,8 +43,8 @@ from planner._steer import (
 from planner._world import World, free_length, motion_free, static_clearance_estimate
 
 # Parameter vector indices.
-(EPS, GAMMA, GOAL_BIAS, RHO, SPEED, GX, GY, GTH, GPOS, GHEAD, INFORMED, STAR, STEERING,
- SX, SY, K_RRT, DIMS, METRIC, POLISH, NPARAMS) = range(20)
+(EPS, GAMMA, GOAL_BIAS, RHO, SIGMA, SPEED, GX, GY, GTH, GPOS, GHEAD, INFORMED, STAR, STEERING,
+ SX, SY, K_RRT, DIMS, METRIC, POLISH, NPARAMS) = range(21)
 STEERING_METRIC, SE2_METRIC = range(2)  # planner.options.METRICS
 LANE_SHARE, LANE_SIGMA = 0.9, 0.25  # track scenarios: headings sampled along the lane
 NEAREST_BUCKETS = 256  # nearest's queue: half-cell buckets, the last one takes the rest
@@ -275,6 +277,12 @@ def _heap_pop(keys, vals, size) -> int:
 
 
 @njit(cache=True, inline="always")
+def turning(P: np.ndarray):
+    """The car's turning constants as the steering functions read them (`cc_constants`)."""
+    return cc_constants(P[RHO], P[SIGMA])
+
+
+@njit(cache=True, inline="always")
 def _se2(a, b, rho) -> float:
     """√(Δx² + Δy² + (ρ·Δθ)²): the cheap metric of many car planners."""
     dth = rho * wrap_angle(b[2] - a[2])
@@ -282,25 +290,25 @@ def _se2(a, b, rho) -> float:
 
 
 @njit(cache=True, inline="always")
-def _metric_bound(metric, code, a, b, rho) -> float:
+def _metric_bound(metric, code, a, b, g) -> float:
     """A lower bound of the nearest-neighbour metric (the chord, for se2)."""
     if metric == SE2_METRIC:
         return math.hypot(b[0] - a[0], b[1] - a[1])
-    return steer_bound(code, a, b, rho)
+    return steer_bound(code, a, b, g)
 
 
 @njit(cache=True, inline="always")
-def _metric_tight_bound(metric, code, a, b, rho) -> float:
+def _metric_tight_bound(metric, code, a, b, g) -> float:
     if metric == SE2_METRIC:
         return 0.0
-    return steer_tight_bound(code, a, b, rho)
+    return steer_tight_bound(code, a, b, g)
 
 
 @njit(cache=True, inline="always")
-def _metric(metric, code, a, b, rho, bound) -> float:
+def _metric(metric, code, a, b, g, bound) -> float:
     if metric == SE2_METRIC:
-        return _se2(a, b, rho)
-    return steer_length(code, a, b, rho, bound)
+        return _se2(a, b, g[0])
+    return steer_length(code, a, b, g, bound)
 
 
 @njit(cache=True)
@@ -317,8 +325,8 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
     tighter `steer_tight_bound` and is filed again (key −1 − bound) if that moves it up: poses
     facing back at the tree pass the turning circles' bound by the hundred on a small track.
     """
-    code, rho, metric = int(P[STEERING]), P[RHO], int(P[METRIC])
-    to = state(qx, qy, qth, math.cos(qth), math.sin(qth), rho)
+    code, g, metric = int(P[STEERING]), turning(P), int(P[METRIC])
+    to = state(qx, qy, qth, math.cos(qth), math.sin(qth), g[0])
     nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
     ci, cj = _cell(tree, qx, qy)
     cells = np.empty(8 * (max(nx, ny) + 1), np.int64)
@@ -340,7 +348,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             if lb >= 0.0:  # filed by its cheap bound: refine it first
                 if lb >= best:
                     continue
-                lb = max(lb, _metric_tight_bound(metric, code, _node(tree, node), to, rho))
+                lb = max(lb, _metric_tight_bound(metric, code, _node(tree, node), to, g))
                 b = min(int(lb / width), NEAREST_BUCKETS - 1)
                 if lb < best and b > cur:  # no longer among the lowest: file it again
                     key[node] = -1.0 - lb
@@ -351,7 +359,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             else:
                 lb = -1.0 - lb  # refined before
             if lb < best:
-                d = _metric(metric, code, _node(tree, node), to, rho, best)
+                d = _metric(metric, code, _node(tree, node), to, g, best)
                 if d < best:
                     best, besti = d, node
         elif ring_bound >= best:
@@ -360,7 +368,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
             for q in range(_ring_cells(tree, ci, cj, k, cells)):
                 node = tree.cell_head[cells[q]]
                 while node >= 0:
-                    lb = _metric_bound(metric, code, _node(tree, node), to, rho)
+                    lb = _metric_bound(metric, code, _node(tree, node), to, g)
                     if lb < best:
                         b = min(int(lb / width), NEAREST_BUCKETS - 1)
                         key[node] = lb
@@ -565,14 +573,15 @@ def _polish_best(tree: Tree, w: World, P: np.ndarray, kinds, lens, curv, counter
     root = nodes[0]
     code = int(P[STEERING])
     goal = np.array([P[GX], P[GY], P[GTH], P[GPOS], P[GHEAD]])
-    poses, length = polish_path(w, code, P[RHO], P[SPEED], poses, goal, (kinds, lens, curv),
+    g = turning(P)
+    poses, length = polish_path(w, code, g, P[SPEED], poses, goal, (kinds, lens, curv),
                                 counter, tree.cnt[ITER] >= BLOCKS_FROM, limit)
     if length >= tree.cost[tree.cnt[BEST]] - 1e-9:
         return False
     parent = root
     for i in range(1, poses.shape[0]):
         a, b = poses[i - 1], poses[i]
-        edge = steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], P[RHO], kinds, lens, curv)
+        edge = steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], g, kinds, lens, curv)
         parent = add_node(tree, P, b[0], b[1], b[2], tree.cost[parent] + edge, parent, kinds,
                           lens, curv)
         if ev.rows.shape[0] > 0 and ev.cnt[3] < ev.polished.shape[0]:
@@ -624,8 +633,8 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
     leaves the winning edge in kinds/lens/curv (pk/pl/pc: scratch).
     """
     keys, vals = tree.near_key, tree.stack
-    code, rho = int(P[STEERING]), P[RHO]
-    to = state(x, y, th, math.cos(th), math.sin(th), rho)
+    code, g = int(P[STEERING]), turning(P)
+    to = state(x, y, th, math.cos(th), math.sin(th), g[0])
     size = 0
     for q in range(m):
         j = tree.near[q]
@@ -633,7 +642,7 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
             continue
         if tree.near_len[q] >= radius or tree.cost[j] + tree.near_len[q] >= c_new - 1e-12:
             continue
-        lb = steer_bound(code, _node(tree, j), to, rho)
+        lb = steer_bound(code, _node(tree, j), to, g)
         if lb < radius and tree.cost[j] + lb < c_new - 1e-12:
             size = _heap_push(keys, vals, size, tree.cost[j] + lb, j)
     while size > 0 and keys[0] < c_new - 1e-12:
@@ -643,11 +652,11 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
         px, py, pth = tree.pose[j, 0], tree.pose[j, 1], tree.pose[j, 2]
         if v >= 0:
             bound = min(radius, c_new - tree.cost[j])
-            d = steer_length(code, _node(tree, j), to, rho, bound)
+            d = steer_length(code, _node(tree, j), to, g, bound)
             if d < bound:
                 size = _heap_push(keys, vals, size, tree.cost[j] + d, -1 - j)
             continue
-        steer_path(code, px, py, pth, x, y, th, rho, pk, pl, pc)
+        steer_path(code, px, py, pth, x, y, th, g, pk, pl, pc)
         tree.cnt[CHECKS] += 1
         if motion_free(w, px, py, pth, tree.cost[j] / P[SPEED], pk, pl, pc, P[SPEED], counter):
             kinds[:] = pk
@@ -671,7 +680,7 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
     cut = np.zeros(tree.lens.shape[1])
     counter = np.zeros(1, np.int64)
     timed = w.m_kind.shape[0] > 0
-    code = int(P[STEERING])
+    code, g = int(P[STEERING]), turning(P)
     status = RAN
     for _ in range(n_iter):
         if tree.cnt[N] >= tree.pose.shape[0]:
@@ -703,13 +712,13 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
         near_i, dist = nearest(tree, P, xr, yr, thr)
         nx0, ny0, nth0 = tree.pose[near_i, 0], tree.pose[near_i, 1], tree.pose[near_i, 2]
         thr = arrival_heading(code, nx0, ny0, nth0, xr, yr, thr)
-        length = steer_path(code, nx0, ny0, nth0, xr, yr, thr, P[RHO], kinds, lens, curv)
+        length = steer_path(code, nx0, ny0, nth0, xr, yr, thr, g, kinds, lens, curv)
         if P[METRIC] == SE2_METRIC:
             dist = length  # the metric chose the node; the edge is driven by the steering
         if dist > P[EPS]:
-            truncate(kinds, lens, P[EPS], cut)
+            dist = min(steer_cut(code, kinds, lens, curv, P[EPS], True), length)
+            truncate(kinds, lens, dist, cut)
             lens[:] = cut
-            dist = P[EPS]
         x, y, th = path_end(nx0, ny0, nth0, kinds, lens, curv)
         th = wrap_angle(th)
         if record:
@@ -727,9 +736,9 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
         if free != math.inf and not timed:
             if record:
                 ev.rows[row, EV_FREE] = free
-            if P[METRIC] == SE2_METRIC or free * KEEP_SHARE < KEEP_MIN * P[RHO]:
+            dist = steer_cut(code, kinds, lens, curv, free * KEEP_SHARE, False)
+            if P[METRIC] == SE2_METRIC or dist < KEEP_MIN * P[RHO]:
                 continue  # the SE(2) nearest's path may loop: its first half is no advance
-            dist = free * KEEP_SHARE
             truncate(kinds, lens, dist, cut)
             lens[:] = cut
             c_new = tree.cost[near_i] + dist
@@ -777,13 +786,13 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
                 continue
             budget = min(tree.cost[j] - c_new, radius)
             if tree.near_len[q] >= budget - 1e-9 or steer_bound(
-                    code, frm, _node(tree, j), P[RHO]) >= budget - 1e-9:
+                    code, frm, _node(tree, j), g) >= budget - 1e-9:
                 continue  # not even the lower bound could make j cheaper
-            l = steer_length(code, frm, _node(tree, j), P[RHO], budget)
+            l = steer_length(code, frm, _node(tree, j), g, budget)
             if l >= budget - 1e-9:
                 continue
             steer_path(code, x, y, th, tree.pose[j, 0], tree.pose[j, 1],
-                       tree.pose[j, 2], P[RHO], kinds, lens, curv)
+                       tree.pose[j, 2], g, kinds, lens, curv)
             tree.cnt[CHECKS] += 1
             if not motion_free(w, x, y, th, c_new / P[SPEED], kinds, lens, curv, P[SPEED],
                                counter):

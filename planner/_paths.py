@@ -37,24 +37,29 @@ _LETTERS = {LEFT: "L", STRAIGHT: "S", RIGHT: "R", TURN: "T"}
 
 
 def path_word(kinds, lens) -> str:
-    """The path's steering word, one letter per segment in driving order: L left arc, S
-    straight, R right arc, T turn on the spot ("LSL", "RSR", "TST"); unused segments are left
-    out. A path that reverses anywhere gives each driven segment its direction, + forward and
-    − reverse, as Reeds and Shepp write their words ("L+R−S−"): a forward-only word stays short,
-    the way Dubins words are known. A turn on the spot drives no way and has no direction. A
-    segment under `MIN_SEGMENT` has no letter, as it has no row in `sample_path`. The empty path
-    (the root's) has the empty word.
+    """The path's steering word, one letter per turn or straight in driving order: L left, S
+    straight, R right, T turn on the spot ("LSL", "RSR", "TST"); unused segments are left out,
+    and segments of one letter driven one way make one letter (a continuous-curvature turn's
+    clothoid, arc and clothoid are one L). A path that reverses anywhere gives each letter its
+    direction, + forward and − reverse, as Reeds and Shepp write their words ("L+R−S−"): a
+    forward-only word stays short, the way Dubins words are known. A turn on the spot drives no
+    way and has no direction. A segment under `MIN_SEGMENT` has no letter, as it has no row in
+    `sample_path`. The empty path (the root's) has the empty word.
 
     >>> import numpy as np
     >>> path_word(np.array([1, 0, 1, 0, 0]), np.array([0.5, 2.0, 0.3, 0.0, 0.0]))
     'LSL'
     >>> path_word(np.array([1, -1, 0, 0, 0]), np.array([0.4, -0.9, -1.0, 0.0, 0.0]))
     'L+R−S−'
+    >>> path_word(np.array([1, 1, 1, 0, 0]), np.array([0.2, 0.5, 0.2, 1.0, 0.0]))
+    'LS'
     """
     segs = [(int(k), float(v)) for k, v in zip(kinds, lens) if _sampled.py_func(k, v)]
     reverses = any(v < 0.0 and k != TURN for k, v in segs)
-    return "".join(_LETTERS[k] + ("" if not reverses or k == TURN else "+" if v > 0 else "−")
-                   for k, v in segs)
+    letters = [_LETTERS[k] + ("" if not reverses or k == TURN else "+" if v > 0 else "−")
+               for k, v in segs]
+    return "".join(a for i, a in enumerate(letters)
+                   if i == 0 or a != letters[i - 1] or a.startswith("T"))
 
 
 @njit(cache=True, inline="always")
@@ -170,12 +175,37 @@ def truncate(kinds: np.ndarray, lens: np.ndarray, s: float, out_lens: np.ndarray
 
 
 @njit(cache=True)
+def rest_points(kinds: np.ndarray, lens: np.ndarray, curv: np.ndarray, s: float):
+    """(before, after): the driven lengths nearest to ``s``, before ≤ s ≤ after, where the
+    path's steering curvature is 0 (−∞ or ∞ where there is none): anywhere on a straight,
+    where a segment's κ0 + σu is 0 at one of its ends, at a turn on the spot."""
+    before, after = -math.inf, math.inf
+    u = 0.0
+    for i in range(kinds.shape[0]):
+        length = driven(kinds[i], lens[i])
+        k0, sigma = curv[i, 0], curv[i, 1]
+        end = u + length
+        flat_start = kinds[i] == TURN or abs(k0) < 1e-12
+        flat_end = kinds[i] == TURN or abs(k0 + sigma * length) < 1e-12
+        if flat_start and sigma == 0.0 and u <= s <= end:
+            return s, s  # on a straight
+        if flat_start and u <= s:
+            before = u
+        if flat_end and end <= s:
+            before = end
+        if flat_end and end > s:
+            return before, end
+        u = end
+    return before, after
+
+
+@njit(cache=True)
 def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarray,
                 curv: np.ndarray, spacing: float) -> np.ndarray:
     """Poses every ≤ ``spacing`` metres, both ends and every segment joint included.
 
-    Returns an (n, 5) array of x, y, theta, curvature (the steering curvature there; at a
-    joint, the segment's that ends there), direction.
+    Returns an (n, 6) array of x, y, theta, curvature (the steering curvature there; at a
+    joint, the segment's that ends there), direction, and the driven length from the start.
     A turn on the spot is one row: the same position, the new heading, curvature 0 (the robot
     does not steer; its heading is free). A segment under `MIN_SEGMENT` (a Dubins word's
     vanishing middle) moves the pose but gives no row: it would repeat the one before.
@@ -186,7 +216,9 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
         if _sampled(kinds[i], lens[i]):
             n += max(1, int(math.ceil(driven(kinds[i], lens[i]) / spacing - 1e-12)))
             first = i if first < 0 else first
-    out = np.empty((n, 5))
+    out = np.empty((n, 6))
+    out[0, 5] = 0.0
+    along = 0.0
     out[0, 0] = x
     out[0, 1] = y
     out[0, 2] = th
@@ -198,6 +230,7 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
         k0, sigma = curv[i, 0], curv[i, 1]
         if not _sampled(kinds[i], seg):
             x, y, th = advance(x, y, th, kinds[i], seg, k0, sigma)
+            along += driven(kinds[i], seg)
             continue
         steps = max(1, int(math.ceil(driven(kinds[i], seg) / spacing - 1e-12)))
         for j in range(1, steps + 1):
@@ -208,8 +241,10 @@ def sample_path(x: float, y: float, th: float, kinds: np.ndarray, lens: np.ndarr
             out[k, 2] = pth
             out[k, 3] = curvature_at(kinds[i], k0, sigma, abs(part))
             out[k, 4] = _direction(kinds[i], seg)
+            out[k, 5] = along + driven(kinds[i], part)
             k += 1
         x, y, th = advance(x, y, th, kinds[i], seg, k0, sigma)
+        along += driven(kinds[i], seg)
     return out
 
 

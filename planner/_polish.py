@@ -46,43 +46,44 @@ def _state(q, rho):
 
 
 @njit(cache=True, inline="always")
-def _length(code: int, a, b, rho: float, bound: float) -> float:
-    return steer_length(code, _state(a, rho), _state(b, rho), rho, bound)
+def _length(code: int, a, b, g, bound: float) -> float:
+    return steer_length(code, _state(a, g[0]), _state(b, g[0]), g, bound)
 
 
 @njit(cache=True)
-def _free(w: World, code: int, a, b, rho: float, speed: float, buf, counter) -> bool:
+def _free(w: World, code: int, a, b, g, speed: float, buf, counter) -> bool:
     kinds, lens, curv = buf
-    steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], rho, kinds, lens, curv)
+    steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], g, kinds, lens, curv)
     return motion_free(w, a[0], a[1], a[2], 0.0, kinds, lens, curv, speed, counter)
 
 
 @njit(cache=True)
-def polish_path(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
+def polish_path(w: World, code: int, g, speed: float, poses: np.ndarray,
                 goal: np.ndarray, buf, counter, blocks: bool, limit: int):
     """The path through ``poses`` ((n, 3)) shortened: (new poses, their length); with
     ``blocks``, each pass also shifts blocks of poses (`_shift_blocks`), which costs a polish
     about twice as much. It stops between two rounds once ``counter`` has passed ``limit``
     clearance evaluations: every step keeps the path free, so where it stops is a path.
-    ``buf``: (kinds, lens, curv), room for one local path (`planner._paths`)."""
+    ``g``: the car's turning constants (`planner._cc_dubins.cc_constants`); ``buf``: (kinds,
+    lens, curv), room for one local path (`planner._paths`)."""
     for _ in range(PASSES):
-        poses = _split(code, rho, poses, buf)
-        _descend(w, code, rho, speed, poses, goal, buf, counter, limit)
+        poses = _split(code, g, poses, buf)
+        _descend(w, code, g, speed, poses, goal, buf, counter, limit)
         if blocks:
             for width in BLOCKS:
-                _shift_blocks(w, code, rho, speed, poses, width, buf, counter, limit)
-            _descend(w, code, rho, speed, poses, goal, buf, counter, limit)
+                _shift_blocks(w, code, g, speed, poses, width, buf, counter, limit)
+            _descend(w, code, g, speed, poses, goal, buf, counter, limit)
         if counter[0] > limit:
             break
-        poses = _prune(w, code, rho, speed, poses, buf, counter)
+        poses = _prune(w, code, g, speed, poses, buf, counter)
     total = 0.0
     for i in range(poses.shape[0] - 1):
-        total += _length(code, poses[i], poses[i + 1], rho, math.inf)
+        total += _length(code, poses[i], poses[i + 1], g, math.inf)
     return poses, total
 
 
 @njit(cache=True)
-def _split(code: int, rho: float, poses: np.ndarray, buf) -> np.ndarray:
+def _split(code: int, g, poses: np.ndarray, buf) -> np.ndarray:
     """Every edge of `SPLIT_MIN`·2ρ or more cut in two at the pose halfway along it (the path
     itself is unchanged). Shorter edges stay whole: a polish that stops at its budget keeps its
     split poses, and splitting every edge each time grew a corridor's best path to 7 446 poses
@@ -94,8 +95,8 @@ def _split(code: int, rho: float, poses: np.ndarray, buf) -> np.ndarray:
         a, b = poses[i], poses[i + 1]
         out[k, :] = a
         k += 1
-        length = steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], rho, buf[0], buf[1], buf[2])
-        if length >= 2.0 * SPLIT_MIN * rho:
+        length = steer_path(code, a[0], a[1], a[2], b[0], b[1], b[2], g, buf[0], buf[1], buf[2])
+        if length >= 2.0 * SPLIT_MIN * g[0]:
             x, y, th, _, _ = pose_at(a[0], a[1], a[2], buf[0], buf[1], buf[2], 0.5 * length)
             out[k, 0] = x
             out[k, 1] = y
@@ -106,26 +107,26 @@ def _split(code: int, rho: float, poses: np.ndarray, buf) -> np.ndarray:
 
 
 @njit(cache=True)
-def _edges(code: int, poses: np.ndarray, rho: float) -> tuple[np.ndarray, float]:
+def _edges(code: int, poses: np.ndarray, g) -> tuple[np.ndarray, float]:
     """The lengths of the path's edges and their mean, summed here: ``edge.mean()`` would make
     every process that loads the kernels import numba's array math (0.05 s)."""
     n = poses.shape[0]
     edge = np.empty(n - 1)
     total = 0.0
     for i in range(n - 1):
-        edge[i] = _length(code, poses[i], poses[i + 1], rho, math.inf)
+        edge[i] = _length(code, poses[i], poses[i + 1], g, math.inf)
         total += edge[i]
     return edge, total / (n - 1)
 
 
 @njit(cache=True)
-def _descend(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
+def _descend(w: World, code: int, g, speed: float, poses: np.ndarray,
              goal: np.ndarray, buf, counter, limit: int) -> None:
     """Coordinate descent on the inner poses and the end pose (within the goal), in place:
     each round moves every pose by the step that shortens its edges most and is free."""
     n = poses.shape[0]
     nm = MOVES.shape[0]
-    edge, mean = _edges(code, poses, rho)
+    edge, mean = _edges(code, poses, g)
     step_xy = 0.25 * mean
     step_th = 0.25
     cand = np.empty((nm, 3))
@@ -145,16 +146,16 @@ def _descend(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
                 gain[m] = 0.0
                 if last and not in_goal(cand[m, 0], cand[m, 1], cand[m, 2], goal):
                     continue
-                a = _length(code, poses[i - 1], cand[m], rho, now)
-                b = 0.0 if last else _length(code, cand[m], poses[i + 1], rho, now - a)
+                a = _length(code, poses[i - 1], cand[m], g, now)
+                b = 0.0 if last else _length(code, cand[m], poses[i + 1], g, now - a)
                 new_a[m], new_b[m] = a, b
                 gain[m] = max(now - a - b, 0.0)
             for m in np.argsort(-gain):
                 if gain[m] <= 1e-9:
                     break
-                if not _free(w, code, poses[i - 1], cand[m], rho, speed, buf, counter):
+                if not _free(w, code, poses[i - 1], cand[m], g, speed, buf, counter):
                     continue
-                if not last and not _free(w, code, cand[m], poses[i + 1], rho, speed, buf,
+                if not last and not _free(w, code, cand[m], poses[i + 1], g, speed, buf,
                                           counter):
                     continue
                 poses[i, :] = cand[m]
@@ -167,7 +168,7 @@ def _descend(w: World, code: int, rho: float, speed: float, poses: np.ndarray,
 
 
 @njit(cache=True)
-def _shift_blocks(w: World, code: int, rho: float, speed: float, poses: np.ndarray, width: int,
+def _shift_blocks(w: World, code: int, g, speed: float, poses: np.ndarray, width: int,
                   buf, counter, limit: int) -> None:
     """Coordinate descent on blocks of ``width`` inner poses shifted together, in place. A
     path that bulges round an obstacle between poses too far apart for any one of them to move
@@ -175,7 +176,7 @@ def _shift_blocks(w: World, code: int, rho: float, speed: float, poses: np.ndarr
     n = poses.shape[0]
     if n - width < 2:
         return
-    edge, mean = _edges(code, poses, rho)
+    edge, mean = _edges(code, poses, g)
     step = 0.25 * mean
     a = np.empty(3)
     b = np.empty(3)
@@ -194,8 +195,8 @@ def _shift_blocks(w: World, code: int, rho: float, speed: float, poses: np.ndarr
                 a[1] += SHIFTS[m, 1] * step
                 b[0] += SHIFTS[m, 0] * step
                 b[1] += SHIFTS[m, 1] * step
-                la = _length(code, poses[i - 1], a, rho, now)
-                lb = _length(code, b, poses[j + 1], rho, now - la)
+                la = _length(code, poses[i - 1], a, g, now)
+                lb = _length(code, b, poses[j + 1], g, now - la)
                 if now - la - lb > best:
                     best, pick, len_a, len_b = now - la - lb, m, la, lb
             if pick < 0:
@@ -204,12 +205,12 @@ def _shift_blocks(w: World, code: int, rho: float, speed: float, poses: np.ndarr
                 moved[k, 0] = poses[i + k, 0] + SHIFTS[pick, 0] * step
                 moved[k, 1] = poses[i + k, 1] + SHIFTS[pick, 1] * step
                 moved[k, 2] = poses[i + k, 2]
-            free = (_free(w, code, poses[i - 1], moved[0], rho, speed, buf, counter)
-                    and _free(w, code, moved[width - 1], poses[j + 1], rho, speed, buf,
+            free = (_free(w, code, poses[i - 1], moved[0], g, speed, buf, counter)
+                    and _free(w, code, moved[width - 1], poses[j + 1], g, speed, buf,
                               counter))
             k = 0
             while free and k < width - 1:
-                free = _free(w, code, moved[k], moved[k + 1], rho, speed, buf, counter)
+                free = _free(w, code, moved[k], moved[k + 1], g, speed, buf, counter)
                 k += 1
             if free:
                 poses[i:j + 1, :] = moved
@@ -219,7 +220,7 @@ def _shift_blocks(w: World, code: int, rho: float, speed: float, poses: np.ndarr
 
 
 @njit(cache=True)
-def _prune(w: World, code: int, rho: float, speed: float, poses: np.ndarray, buf,
+def _prune(w: World, code: int, g, speed: float, poses: np.ndarray, buf,
            counter) -> np.ndarray:
     """The poses the path can skip dropped: from each kept pose, straight on to the farthest
     later pose (of the next `LOOKAHEAD`) that one free steered edge reaches more shortly than
@@ -227,7 +228,7 @@ def _prune(w: World, code: int, rho: float, speed: float, poses: np.ndarray, buf
     n = poses.shape[0]
     along = np.zeros(n)  # driven length from the start to each pose
     for i in range(n - 1):
-        along[i + 1] = along[i] + _length(code, poses[i], poses[i + 1], rho, math.inf)
+        along[i + 1] = along[i] + _length(code, poses[i], poses[i + 1], g, math.inf)
     keep = np.zeros(n, np.int64)
     kept = 1
     i = 0
@@ -235,8 +236,8 @@ def _prune(w: World, code: int, rho: float, speed: float, poses: np.ndarray, buf
         nxt = i + 1
         for j in range(min(n - 1, i + LOOKAHEAD), i + 1, -1):
             via = along[j] - along[i]
-            if (_length(code, poses[i], poses[j], rho, via) < via - 1e-9
-                    and _free(w, code, poses[i], poses[j], rho, speed, buf, counter)):
+            if (_length(code, poses[i], poses[j], g, via) < via - 1e-9
+                    and _free(w, code, poses[i], poses[j], g, speed, buf, counter)):
                 nxt = j
                 break
         keep[kept] = nxt

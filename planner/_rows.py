@@ -16,7 +16,8 @@ import numpy as np
 
 from planner._world import REACH, World, least_clearance
 
-__all__ = ["CHECK_M", "CHECK_S", "SPACING_M", "chord_sag", "polyline", "polyline_clearance"]
+__all__ = ["CHECK_M", "CHECK_S", "SPACING_M", "chord_sag", "chord_sharpness", "polyline",
+           "polyline_clearance"]
 
 SPACING_M = 0.05  # m between rows, at most (docs/scenario-format.md)
 CHECK_M, CHECK_S = 0.005, 0.01  # returned paths are re-checked every 5 mm (and 10 ms of a wait)
@@ -26,6 +27,13 @@ def chord_sag(rho: float, spacing: float = SPACING_M) -> float:
     """The farthest a chord between rows ``spacing`` m apart on arcs of radius ``rho`` strays
     from the arc: ρ(1 − cos(L/2ρ)) ≤ L²/(8ρ)."""
     return spacing * spacing / (8.0 * rho)
+
+
+def chord_sharpness(sigma: float, rho: float, spacing: float = SPACING_M) -> float:
+    """The sharpness to plan with so that rows ``spacing`` m apart change κ by at most ``sigma``
+    times their chord, not only times the arc between them: at curvature ≤ 1/ρ a chord is at
+    least L(1 − (L/ρ)²/24) of its arc's length L."""
+    return sigma * (1.0 - (spacing / rho) ** 2 / 24.0)
 
 
 def polyline(rows: np.ndarray, step: float = CHECK_M, time_step: float = CHECK_S,

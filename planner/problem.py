@@ -36,6 +36,15 @@ class Problem:
     timed: bool
     margin: float = 0.0  # the vehicle's safety margin: planned paths keep it
     max_speed: float | None = None  # the vehicle's top speed (None: ``speed``)
+    max_steer_rate: float = math.inf  # rad/s the steering turns at most
+    wheelbase: float = 1.0
+
+    def sharpness(self, speed: float) -> float:
+        """σmax (1/m²): the most a path driven at ``speed`` may change its curvature per metre
+        so that the steering angle δ = atan(Lκ) turns no faster than the servo can:
+        dδ/dt = Lσv/(1 + L²κ²) ≤ Lσv, so σmax = max_steer_rate/(v·L) is safe at any δ, with
+        the margin 1/cos²δ at the steering angle δ (docs/planner.md)."""
+        return self.max_steer_rate / (speed * self.wheelbase)
 
     @property
     def top_speed(self) -> float:
@@ -140,7 +149,9 @@ def compile_problem(scenario: Scenario, load_track=None) -> Problem:
         goal_position_tol=tol.position, goal_heading_tol=math.radians(tol.heading_deg),
         rho=scenario.vehicle.turning_radius, speed=scenario.vehicle.speed,
         timed=scenario.has_motion, margin=scenario.vehicle.safety_margin,
-        max_speed=scenario.vehicle.max_speed)
+        max_speed=scenario.vehicle.max_speed,
+        max_steer_rate=math.radians(scenario.vehicle.max_steer_rate_deg_s),
+        wheelbase=scenario.vehicle.wheelbase)
     check_room(problem, problem.margin)
     return problem
 

@@ -45,6 +45,9 @@ class PlanReport(BaseModel):
                                                 "timing optimal) every ≤ 0.05 m (and ≤ 0.1 s "
                                                 "with timing optimal) from the start to the "
                                                 "goal node")
+    curvature: list[float] = Field(
+        [], description="κ (1/m) at each path row, as the steering drives it (positive: left): "
+                        "the steering angle there is atan(wheelbase·κ)")
     parameters: dict
 
 
@@ -69,6 +72,7 @@ def plan_report(result: Result, scenario_name: str, budget: dict) -> PlanReport:
         rewires=result.rewires,
         refused_rewires=result.refused_rewires,
         cost_over_time=[(round(t, 6), c, i) for t, c, i in result.cost_over_time], path=path,
+        curvature=result.path[:, 3].round(6).tolist() if result.solved else [],
         parameters={**result.options.model_dump(), **budget,
                     "motion_check": "exact (clearance stepping)"},
     )

@@ -18,7 +18,7 @@ from planner import _kernel as K
 from planner._paths import TURN, advance, path_buffers, pose_at, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
-from planner._rows import SPACING_M, chord_sag, polyline_clearance
+from planner._rows import SPACING_M, chord_sag, chord_sharpness, polyline_clearance
 from planner._steer import steer_path
 from planner._world import World, inflated
 from planner.options import METRICS, PlanOptions
@@ -102,6 +102,7 @@ class Planner:
         P = np.zeros(K.NPARAMS)
         P[K.EPS], P[K.GAMMA], P[K.GOAL_BIAS] = s.eps, s.gamma, s.goal_bias
         P[K.RHO], P[K.SPEED] = problem.rho, s.speed
+        P[K.SIGMA] = chord_sharpness(problem.sharpness(s.speed), problem.rho)
         P[K.GX], P[K.GY], P[K.GTH] = problem.goal
         P[K.GPOS] = problem.goal_position_tol
         P[K.GHEAD] = math.pi if steering.heading_free else problem.goal_heading_tol
@@ -196,7 +197,7 @@ class Planner:
         motion the tree does not hold, such as a Steer that an obstacle blocked."""
         steering = STEERINGS[self.options.steering]
         path = path_buffers(steering.segments)
-        steer_path(steering.code, *a, *b, self.problem.rho, *path)
+        steer_path(steering.code, *a, *b, K.turning(self._P), *path)
         return path_points(a, *path, count)
 
     @property
@@ -320,14 +321,17 @@ class Planner:
         chain = self.best_path_nodes()
         if not chain:
             return np.zeros((0, 6))
-        parts = [np.array([[*t.pose[chain[0]], 0.0, 1.0]])]
+        parts = [np.array([[*t.pose[chain[0]], 0.0, 1.0, 0.0]])]
+        driven = 0.0
         for node in chain[1:]:
             par = t.parent[node]
             seg = sample_path(*t.pose[par], t.kinds[node], t.lens[node], t.curv[node], spacing)
+            seg[:, 5] += driven
+            driven = seg[-1, 5]
             parts.append(seg[1:])
         pts = np.vstack(parts)
-        driven = np.concatenate([[0.0], np.cumsum(_step_lengths(pts))])
-        return np.column_stack([pts, driven / self.options.speed])
+        pts[:, 5] /= self.options.speed
+        return pts
 
     def best_path_segments(self) -> tuple[np.ndarray, ...]:
         """The best path as its driven segments: start poses (m, 3), kinds, signed lengths,
@@ -459,15 +463,6 @@ def _named(ev: K.Events) -> TreeEvents:
         rewires=[Rewire(*map(int, r)) for r in ev.rewires[:n_rw]],
         polished=ev.polished[:n_polished].copy(),
         _near=ev.near[:n_near].copy(), _near_span=ints([K.EV_NEAR_START, K.EV_NEAR_END]))
-
-
-def _step_lengths(pts: np.ndarray) -> np.ndarray:
-    """Driven length between consecutive samples (arc, not chord): |Δθ|·ρ on arcs."""
-    chord = np.hypot(*np.diff(pts[:, :2], axis=0).T)
-    dth = np.abs(np.diff(np.unwrap(pts[:, 2])))
-    kappa = np.abs(pts[1:, 3])
-    arc = np.where(kappa > 0, dth / np.where(kappa > 0, kappa, 1.0), chord)
-    return np.maximum(arc, chord)
 
 
 def checked_world(world: World, rho: float, options: PlanOptions) -> World:

@@ -2,7 +2,8 @@
 
 Every edge of the system takes its list from `STEERINGS`: the options model (`PlanOptions`),
 `trackstar plan --steering`, the REST schema, the studio's dropdown and docs. The compiled
-implementations live one per module (`_dubins.py`, `_reeds_shepp.py`, `_straight.py`); the
+implementations live one per module (`_dubins.py`, `_reeds_shepp.py`, `_straight.py`,
+`_cc_dubins.py`); the
 planner's kernel reaches them through `_steer.py` by each entry's integer ``code``, and stores
 their paths in the segment form of `_paths.py`, ``segments`` wide. Adding a
 steering function is: its module, an entry here, a branch per function in `_steer.py`.
@@ -15,7 +16,8 @@ from typing import Literal
 
 __all__ = ["DEFAULT_STEERING", "STEERINGS", "Steering", "SteeringName"]
 
-DUBINS, REEDS_SHEPP, STRAIGHT = range(3)  # the kernel's codes (`_steer.py` dispatches on them)
+# the kernel's codes (`_steer.py` dispatches on them)
+DUBINS, REEDS_SHEPP, STRAIGHT, CC_DUBINS = range(4)
 
 
 @dataclass(frozen=True)
@@ -29,7 +31,9 @@ class Steering:
     from it (`planner._rows.chord_sag`). ``curvature``: what its paths' curvature profile looks
     like (the studio's caption). ``ompl_space``: OMPL's state space of the same paths (None: OMPL
     has none). ``segments``: the most segments one of its paths has (the width of its paths'
-    arrays in the segment form of `planner._paths`).
+    arrays in the segment form of `planner._paths`). ``continuous``: its curvature never
+    jumps — it ramps at most at the car's sharpness σmax, and its paths start and end at κ = 0.
+    ``shortest``: its paths are the shortest ones (the triangle inequality holds).
     """
 
     name: str
@@ -42,6 +46,8 @@ class Steering:
     ompl_space: str | None = None
     curved: bool = True
     segments: int = 5  # Reeds-Shepp's longest words (C|C(π/2)SC(π/2)|C) have five
+    continuous: bool = False
+    shortest: bool = True
 
 
 STEERINGS = {s.name: s for s in (
@@ -60,6 +66,13 @@ STEERINGS = {s.name: s for s in (
              "position (the classic RRT picture, LaValle 1998)",
              "Straight lines: κ = 0 all along; the robot turns on the spot between them.",
              curved=False),
+    Steering("cc-dubins", "CC-Dubins", CC_DUBINS, False, False,
+             "forward only, continuous curvature: clothoids into and out of every turn "
+             "(Fraichard & Scheuer 2004)",
+             "CC-Dubins paths ramp κ up to ±1/ρ and back down along clothoids of sharpness "
+             "σmax, so κ(s) has ramps where Dubins has steps, and δ(s) is a steering servo's "
+             "to follow; dδ/dt stays within vehicle.max_steer_rate_deg_s at the planned speed.",
+             segments=9, continuous=True, shortest=False),
 )}
 DEFAULT_STEERING = next(iter(STEERINGS))
 

@@ -293,6 +293,30 @@ def arc_mismatch(path) -> float:
     return worst
 
 
+def clothoid_mismatch(path) -> float:
+    """Largest position error (m) of reconstructing each gap of a continuous-curvature path as
+    one clothoid: κ linear from the row before's κ to the next row's, driven in the next row's
+    direction (columns x, y, θ, κ, direction), its length from the heading change (the chord
+    where κ is 0 at both ends), integrated by Simpson's rule."""
+    path = np.asarray(path, dtype=float)
+    u = np.linspace(0.0, 1.0, 33)
+    weights = np.ones(33)
+    weights[1:-1:2], weights[2:-1:2] = 4.0, 2.0
+    worst = 0.0
+    for p, q in zip(path[:-1], path[1:]):
+        chord = math.hypot(q[0] - p[0], q[1] - p[1])
+        if chord < 1e-12:
+            continue
+        d, k0, k1 = q[4], p[3], q[3]
+        dth = (q[2] - p[2] + math.pi) % (2 * math.pi) - math.pi
+        length = chord if abs(k0 + k1) < 1e-9 else 2.0 * d * dth / (k0 + k1)
+        th = p[2] + d * length * (k0 * u + 0.5 * (k1 - k0) * u * u)
+        x = p[0] + d * length * np.dot(weights, np.cos(th)) / 96.0
+        y = p[1] + d * length * np.dot(weights, np.sin(th)) / 96.0
+        worst = max(worst, math.hypot(x - q[0], y - q[1]))
+    return worst
+
+
 def schedule_errors(path, max_speed: float, rounding: float = 0.0) -> list[str]:
     """docs/scenario-format.md v1.3's rules for a timed path of ``timing: optimal``: t from 0 and
     non-decreasing, at most ``max_speed`` between entries (1 % tolerance, and ``rounding`` m

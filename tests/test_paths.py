@@ -46,11 +46,13 @@ def test_samples_are_continuous_and_end_at_the_end(kinds, lens, rho):
 
 
 def _word(steering: str, goal, rho: float = 1.0) -> str:
+    from planner._cc_dubins import cc_constants
     from planner._steer import steer_path
     from planner.steering import STEERINGS
 
     kinds, lens, curv = path_buffers(STEERINGS[steering].segments)
-    steer_path(STEERINGS[steering].code, 0.0, 0.0, 0.0, *map(float, goal), rho, kinds, lens, curv)
+    steer_path(STEERINGS[steering].code, 0.0, 0.0, 0.0, *map(float, goal),
+               cc_constants(rho, math.inf), kinds, lens, curv)
     return path_word(kinds, lens)
 
 
@@ -83,16 +85,18 @@ def test_a_turn_on_the_spot_is_t_without_a_direction():
 @settings(max_examples=100, deadline=None)
 @given(kinds_st, st.lists(lengths, min_size=5, max_size=5))
 def test_the_word_names_the_segments_a_path_samples(kinds, lens):
-    """One letter per segment that moves (MIN_SEGMENT at least, or a turn on the spot), and
-    where a sign is written it is the driving direction `sample_path` gives that segment's
-    poses."""
+    """One letter per run of segments that move (MIN_SEGMENT at least, or a turn on the spot)
+    with one letter and direction, and where a sign is written it is the driving direction
+    `sample_path` gives that run's poses."""
     kinds, lens = np.array(kinds, dtype=np.int8), np.array(lens)
     word = path_word(kinds, lens)
-    letters = [c for c in word if c in "LSR"]
-    assert letters == ["LSR"[1 - k] for k, v in zip(kinds, lens) if abs(v) > MIN_SEGMENT]
-    signs = [c for c in word if c in "+−"]
     rows = sample_path(0.0, 0.0, 0.0, kinds, lens, arcs(kinds, 1.0), 10.0)[1:, 4]  # a row per segment
-    assert signs == ([] if (rows > 0).all() else ["+" if d > 0 else "−" for d in rows])
+    moving = [("LSR"[1 - k], d) for (k, v), d in
+              zip([(k, v) for k, v in zip(kinds, lens) if abs(v) > MIN_SEGMENT], rows)]
+    runs = [m for i, m in enumerate(moving) if i == 0 or m != moving[i - 1]]
+    assert [c for c in word if c in "LSR"] == [letter for letter, _ in runs]
+    signs = [c for c in word if c in "+−"]
+    assert signs == ([] if (rows > 0).all() else ["+" if d > 0 else "−" for _, d in runs])
 
 
 def cc_turn(kappa: float, sigma: float, arc: float, direction: float = 1.0):

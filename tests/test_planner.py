@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from checker import arc_mismatch, first_collision
+from checker import arc_mismatch, clothoid_mismatch, first_collision
 from conftest import STATIC, scenario_dict
 
 import planner
@@ -32,7 +32,13 @@ def test_paths_are_valid_continuous_and_feasible(name, steering):
     assert np.all(np.abs(path[:, 3]) <= 1 / rho + 1e-9)
     if steering == "straight":
         assert np.all(path[:, 3] == 0.0)
-    assert arc_mismatch(path[:, :3]) < 1e-6
+    if planner.STEERINGS[steering].continuous:  # κ ramps within the servo's rate (180°/s)
+        assert clothoid_mismatch(path) < 1e-9
+        sigma = math.radians(180) / (result.options.speed * 0.44)
+        steps = np.hypot(*np.diff(path[:, :2], axis=0).T)
+        assert np.all(np.abs(np.diff(path[:, 3])) <= sigma * steps + 1e-12)
+    else:
+        assert arc_mismatch(path[:, :3]) < 1e-6
     assert first_collision(scn, path[:, :3]) is None
     # The reported cost is the driven length of the returned path.
     steps = np.hypot(*np.diff(path[:, :2], axis=0).T)
@@ -186,7 +192,7 @@ def test_nearest_is_the_true_nearest_by_steering_length(name, steering):
     for _ in range(150):
         q = (rng.uniform(xmin, xmax), rng.uniform(ymin, ymax), rng.uniform(-math.pi, math.pi))
         node, found = K.nearest(tree, run._P, *q)
-        lengths = [steer_path(code, *tree.pose[j], *q, problem.rho, *path)
+        lengths = [steer_path(code, *tree.pose[j], *q, K.turning(run._P), *path)
                    for j in range(n)]
         assert found == pytest.approx(min(lengths), abs=1e-9)
         assert lengths[node] == pytest.approx(found, abs=1e-9)
