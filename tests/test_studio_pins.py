@@ -57,7 +57,7 @@ def test_the_profiles_shade_each_pins_reverse_in_its_colour():
     gui = SimpleNamespace(add_uplot=lambda data, series, **k: charts.append(
         SimpleNamespace(data=data, series=series)) or charts[-1],
                           add_markdown=lambda content: SimpleNamespace(content=content))
-    profiles = Profiles(gui, np.linspace(0, 14, 50), np.zeros(50), 10.0, 0.3, 30.0,
+    profiles = Profiles(gui, np.linspace(0, 14, 50), np.zeros(50), 10.0, 0.3, 30.0, 180.0,
                         raceline_limits(vehicle=CAR))
     profiles.set_pins(_pins(CAR, CAR).runs)
     for chart, symbol in zip(charts[:2], (" κ", " δ")):  # curvature, steering

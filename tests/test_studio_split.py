@@ -158,7 +158,7 @@ def test_a_chart_gets_its_data_before_new_series_of_the_same_number():
     gui = SimpleNamespace(add_uplot=lambda data, series, **k: charts.append(
         _Chart(log=[], data=data, series=series)) or charts[-1],
                           add_markdown=lambda content: SimpleNamespace(content=content))
-    profiles = Profiles(gui, np.linspace(0, 14, 50), np.zeros(50), 10.0, 0.44, 26.0,
+    profiles = Profiles(gui, np.linspace(0, 14, 50), np.zeros(50), 10.0, 0.44, 26.0, 180.0,
                         raceline_limits(vehicle=Vehicle()))
     curvature = charts[0]
     profiles.show_path(np.zeros((0, 6)))

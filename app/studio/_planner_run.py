@@ -69,6 +69,7 @@ class PlannerRun:
             self._profiles = Profiles(self.gui, prof.s, prof.curvature,
                                       goal_fraction(track.closed) * track.length_m,
                                       vehicle.wheelbase, vehicle.max_steer_deg,
+                                      vehicle.max_steer_rate_deg_s,
                                       raceline_limits(vehicle=vehicle))
         if track is not self._track:
             self._track = track

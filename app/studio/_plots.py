@@ -1,5 +1,7 @@
 """Profile plots (uPlot through viser): curvature and steering along the best path beside the
-track centreline, the ±δmax band shaded; the fastest speed the car may drive the path at under
+track centreline, the ±δmax band shaded; the steering rate dδ/dt the path asks of the servo as
+it is driven (its t column) against ±max_steer_rate — Dubins' steps are spikes off the chart,
+continuous-curvature ramps stay inside; the fastest speed the car may drive the path at under
 its speed limit and lateral and longitudinal accelerations (`tracks.path_rows`, the raceline's
 profile), under the shaded envelope min(v_max, √(a_lat/|κ|)); and the best cost over planning
 time.
@@ -64,6 +66,17 @@ def _for_uplot(data: tuple) -> tuple:
             v[0] = first[0] if len(first) else fallback
         out.append(v)
     return (x, *out)
+
+
+def _rate(s_grid: np.ndarray, path: np.ndarray, wheelbase: float) -> np.ndarray:
+    """dδ/dt (deg/s) along a path (columns x, y, θ, κ, direction, t) at the grid points: the
+    change of δ between rows over the time between them; none where no time passes (a turn on
+    the spot, which does not steer)."""
+    if len(path) < 2:
+        return np.full(len(s_grid), math.nan)
+    dt = np.diff(path[:, 5])
+    rate = np.diff(_steer_deg(path[:, 3], wheelbase)) / np.where(dt > 0, dt, math.nan)
+    return _along(s_grid, arc_length(path)[1:], rate)
 
 
 def _held(grid: np.ndarray, t: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -131,19 +144,20 @@ class Profiles:
     """Four uPlot charts in a GUI container, refreshed when the best path changes."""
 
     def __init__(self, gui, centre_s, centre_kappa, goal_s: float, wheelbase: float,
-                 max_steer_deg: float, limits: tracks.Limits) -> None:
+                 max_steer_deg: float, max_steer_rate_deg_s: float,
+                 limits: tracks.Limits) -> None:
         self._cs, self._ck = np.asarray(centre_s), np.asarray(centre_kappa)
         self._pins: list = []  # `_compare.Run`s
         self._split = None  # run B of the two-up split, a `_compare.Run`
         self._shown_series = None  # what the charts' series were made for
         self._path, self._current = np.zeros((0, 4)), None  # the current run, as shown
         self._goal_s = goal_s
-        self._wb, self._dmax = wheelbase, max_steer_deg
+        self._wb, self._dmax, self._rmax = wheelbase, max_steer_deg, max_steer_rate_deg_s
         self._kmax = math.tan(math.radians(max_steer_deg)) / wheelbase
         self._limits = limits
         band = ({"series": (3, 4), "fill": "rgba(80,200,120,0.12)"},)
         self._cusps: tuple = ()  # the grid indices of the current path's cusps
-        kappa, steer, speed = map(_for_uplot, self._profiles(np.zeros((0, 4))))
+        kappa, steer, rate, speed = map(_for_uplot, self._profiles(np.zeros((0, 6))))
         common = {"aspect": 1.6, "bands": band, "legend": {"show": True}, "scales": NUMERIC_X}
         self.caption = gui.add_markdown(STEERINGS[DEFAULT_STEERING].curvature)
         self.curvature = gui.add_uplot(
@@ -156,6 +170,12 @@ class Profiles:
                     _series("path δ", CURRENT, 2.0), _series("+δmax", "#2e9e5b", 1, [4, 4]),
                     _series("−δmax", "#2e9e5b", 1, [4, 4]), *_reverse_series(self._dmax)),
             title="Steering δ (deg) vs s (m)", **common)
+        self.rate = gui.add_uplot(
+            rate, (_series("s (m)"), _series("path dδ/dt", CURRENT, 2.0),
+                   _series("+servo", "#2e9e5b", 1, [4, 4]), _series("−servo", "#2e9e5b", 1, [4, 4])),
+            title="Steering rate dδ/dt (deg/s) vs s (m), as driven",
+            **common | {"bands": ({"series": (2, 3), "fill": "rgba(80,200,120,0.12)"},),
+                        "scales": NUMERIC_X | {"y": {"range": [-2 * self._rmax, 2 * self._rmax]}}})
         self.speed = gui.add_uplot(
             speed, (_series("s (m)"), _series("path v", CURRENT, 2.0),
                     _series(f"limit (v ≤ {limits.v_max:g}, a_lat ≤ {limits.a_lat:g}, "
@@ -168,10 +188,11 @@ class Profiles:
             (_series("planning time (s)"), _series("best cost (m)", CURRENT, 2.0)),
             title="Best cost over time", aspect=2.2, scales=NUMERIC_X)
         self._series = [h.series for h in (self.curvature, self.steering, self.cost)]  # no pins
+        self._rate_series = self.rate.series
 
     @property
     def handles(self) -> tuple:
-        return self.caption, self.curvature, self.steering, self.speed, self.cost
+        return self.caption, self.curvature, self.steering, self.rate, self.speed, self.cost
 
     def set_steering(self, name: str) -> None:
         """The caption for paths of this steering (`planner.STEERINGS`' names)."""
@@ -182,11 +203,11 @@ class Profiles:
         """The compared runs besides the current one: the pins, then run B."""
         return [*self._pins, *([self._split] if self._split is not None else [])]
 
-    def _profiles(self, path: np.ndarray) -> tuple[tuple, tuple, tuple]:
+    def _profiles(self, path: np.ndarray) -> tuple[tuple, tuple, tuple, tuple]:
         """(curvature, steering data): x, centreline, path, +max, −max, the path's reverse
         shading and cusps, each other run's reverse shading, each other run (`_others`), on
-        one s grid as long as the longest path (with the cusps' s in it); (speed data): x,
-        the path's speed, its envelope, 0."""
+        one s grid as long as the longest path (with the cusps' s in it); (rate data): x, the
+        path's dδ/dt, ±the servo's limit; (speed data): x, the path's speed, its envelope, 0."""
         others = self._others
         paths = [path, *(r.path for r in others)]
         end = max((arc_length(p)[-1] for p in paths if len(p) >= 2), default=self._goal_s)
@@ -205,7 +226,9 @@ class Profiles:
                  self._dmax * one, -self._dmax * one,
                  _shade(rev, self._dmax), marks, *(_shade(r, self._dmax) for r in revs),
                  *(_steer_deg(k, r.vehicle.wheelbase) for k, r in zip(pins, others)))
-        return kappa, steer, self._speed(grid, path)
+        rate = (grid, _rate(grid, path, self._wb), self._rmax * one, -self._rmax * one,
+                *(_rate(grid, r.path, r.vehicle.wheelbase) for r in others))
+        return kappa, steer, rate, self._speed(grid, path)
 
     def _speed(self, grid: np.ndarray, path: np.ndarray) -> tuple:
         """The path's fastest speed profile and its envelope on the grid (NaN without one)."""
@@ -221,7 +244,7 @@ class Profiles:
     def show_path(self, path: np.ndarray, split=None) -> None:
         """The current run's best path and, in the split, run B (a `_compare.Run`)."""
         self._path, self._split = path, split
-        kappa, steer, speed = self._profiles(path)
+        kappa, steer, rate, speed = self._profiles(path)
         # viser's client rebuilds a chart whose series change and keeps its x zoom relative
         # to the data: a rebuild with a new x range keeps a stale one. While the series are
         # as many, the data goes first, so that a rebuild finds its x range in place.
@@ -230,6 +253,7 @@ class Profiles:
             self._sync_series()
         self.curvature.data = _for_uplot(kappa)
         self.steering.data = _for_uplot(steer)
+        self.rate.data = _for_uplot(rate)
         self.speed.data = _for_uplot(speed)
         if first:
             self._sync_series()
@@ -260,6 +284,11 @@ class Profiles:
                 shades = tuple(_other_shade(r, limit) for r in others)
             h.series = base + shades + tuple(_series(r.name + symbol, r.colour, 1.5)
                                              for r in others)
+        base = self._rate_series
+        if self._split is not None:
+            base = (base[0], base[1] | {"label": "A dδ/dt"}, *base[2:])
+        self.rate.series = base + tuple(_series(r.name + " dδ/dt", r.colour, 1.5)
+                                        for r in others)
 
     def show_cost(self, current, split=None) -> None:
         """The current run's (a `_compare.Run`) best cost against planning time and the other
