@@ -19,6 +19,7 @@ from pydantic import ConfigDict, Field
 
 from app.planning import TrackSource, track_loader
 from planner.options import TIMINGS, Seed
+from planner.steering import DEFAULT_STEERING, STEERINGS
 from planner.validation import KnownKeys
 
 __all__ = ["MAX_DURATION_S", "SimOptions", "SimulationStopped", "read_progress",
@@ -32,6 +33,8 @@ MAX_LATENCY_MS = 60_000.0  # a fixed cycle time of a minute
 MAX_PREDICT_ACCEL, MAX_PREDICT_SPEED, MAX_PREDICT_HORIZON_S = 100.0, 100.0, 60.0
 
 Rate = Annotated[float, Field(ge=MIN_RATE_HZ, le=MAX_RATE_HZ, allow_inf_nan=False)]
+# A car's steerings: the simulated car cannot turn on the spot.
+CarSteering = Literal[tuple(name for name, s in STEERINGS.items() if not s.heading_free)]
 PROGRESS_EVERY_S = 0.25  # wall time between progress writes
 
 
@@ -72,6 +75,9 @@ class SimOptions(KnownKeys):
         None, description="s of look-ahead over which the predictions grow; held beyond "
                           "(default: the scenario's prediction.horizon, else 1.5)")
     reverse: bool = Field(True, description="the car may back up to evade a mover")
+    steering: CarSteering = Field(
+        DEFAULT_STEERING, description="the replanner's steering: " + "; ".join(
+            f"{s.name} {s.summary}" for s in STEERINGS.values() if not s.heading_free))
 
     def settings(self, **local):
         """The `planner.sim.SimSettings` of these options and of ``local`` ones (the command

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from planner import _kernel as K
-from planner._paths import TURN, advance, path_buffers, pose_at, sample_path
+from planner._paths import TURN, advance, path_buffers, pose_at, rest_points, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
 from planner._rows import SPACING_M, chord_sag, chord_sharpness, polyline_clearance
@@ -379,6 +379,14 @@ class Planner:
         x, y, th, _, _ = pose_at(*t.pose[parent], t.kinds[node], t.lens[node], t.curv[node],
                                  skip)
         return (x, y, th), node, float(skip)
+
+    def rest_from(self, s: float) -> float:
+        """The least driven length ≥ ``s`` along the best path where its curvature is 0 (its
+        end, if there is none): where a continuous-curvature plan may hand over to a new one,
+        whose edges all start at κ = 0."""
+        _, kinds, lens, curv, _ = self.best_path_segments()
+        before, after = rest_points(kinds.astype(np.int8), lens, curv, s)
+        return s if before == s else min(after, float(np.abs(lens).sum()))
 
     def _pose(self, node: int) -> tuple[float, float, float]:
         return tuple(float(v) for v in self._tree.pose[node])

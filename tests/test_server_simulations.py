@@ -89,6 +89,7 @@ def test_laps_of_a_stored_scenario_with_progress(server):
     ({"scenario": THESIS, "duration": 1e6}, 422, "less than or equal to 600"),
     ({"scenario": THESIS, "control_rate": 1e12}, 422, "less than or equal to 1000"),
     ({"scenario": THESIS, "controller": "lqr"}, 422, "pure-pursuit"),
+    ({"scenario": THESIS, "steering": "straight"}, 422, "cc-dubins"),
     ({"scenario": THESIS, "seeds": [1]}, 422, "unknown key 'seeds' (did you mean 'seed'?)"),
     ({"scenario": THESIS, "scenario_id": "x"}, 422, "exactly one of"),
     ({}, 422, "exactly one of"),

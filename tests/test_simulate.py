@@ -248,6 +248,7 @@ def _with(tmp_path, name="crossing", **changes):
     (["--rate", "0"], "--rate"), (["--duration", "-1"], "--duration"),
     (["--control-rate", "nan"], "--control-rate"), (["--controller", "lqr"], "--controller"),
     (["--sense-rate", "0"], "--sense-rate"), (["--timing", "fastest"], "--timing"),
+    (["--steering", "straight"], "--steering"), (["--steering", "cc-dubbins"], "--steering"),
 ])
 def test_cli_rejects_bad_options(args, needle):
     r = _cli("crossing", *args, timeout=30)

@@ -31,7 +31,7 @@ def view():
 
 
 def test_the_view_draws_the_frame_it_received(view):
-    view.start(planner.compile_problem(planner.load_scenario("crossing")), view.settings())
+    view.start(planner.compile_problem(planner.load_scenario("crossing")), view.settings("dubins"))
     run = view.run
     deadline = time.monotonic() + 60
     while (run.frame is None or run.frame.t < 1.5 or run.tree_version == 0) and (
@@ -72,7 +72,7 @@ def test_a_collision_and_a_stall_are_marked_where_and_when_with_their_cause(view
     for scenario, kind, cause in ((planner.load_scenario("stop_in_lane"), "collision",
                                    "clearance"),
                                   (planner.parse_scenario(gate), "stall", "no path found")):
-        settings = dataclasses.replace(view.settings(), realtime=False, duration=12.0,
+        settings = dataclasses.replace(view.settings("dubins"), realtime=False, duration=12.0,
                                        replan=scenario.name != "stop_in_lane")
         view.start(planner.compile_problem(scenario), settings)
         run = view.run
@@ -98,7 +98,7 @@ def test_movers_that_keep_to_the_track_are_drawn_predicted_along_it(view):
     """thesis_half_lap predicts its disc along the track (prediction.along_track): the drawn
     prediction bends with the track, onto where the disc will truly be."""
     problem = planner.compile_problem(planner.load_scenario("thesis_half_lap"))
-    view.start(problem, dataclasses.replace(view.settings(), realtime=False, duration=3.0))
+    view.start(problem, dataclasses.replace(view.settings("dubins"), realtime=False, duration=3.0))
     run = view.run
     deadline = time.monotonic() + 60
     while run.running and time.monotonic() < deadline:
@@ -123,7 +123,7 @@ def test_a_mover_seen_turning_at_once_gets_its_reachable_set_drawn(view):
     crossing = scenario_dict("crossing")
     crossing["obstacles"][0]["motion"] = {"waypoints": [[-1, 0, -0.8], [1, 0, 0.8], [3, 0, -0.8]]}
     problem = planner.compile_problem(planner.parse_scenario(crossing))
-    settings = dataclasses.replace(view.settings(), realtime=False, duration=0.8)
+    settings = dataclasses.replace(view.settings("dubins"), realtime=False, duration=0.8)
     view.start(problem, settings)
     while view.run.running:
         time.sleep(0.05)

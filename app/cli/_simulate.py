@@ -49,6 +49,9 @@ def simulate(
              "scenario's prediction.horizon, else 1.5.")] = None,
     reverse: Annotated[bool, typer.Option(
         help="The car may back up to evade a mover.")] = True,
+    steering: Annotated[str, typer.Option(
+        help="The replanner's steering: dubins, reeds-shepp or cc-dubins (continuous "
+             "curvature, which a steering servo can follow).")] = "dubins",
     realtime: Annotated[bool, typer.Option(help="Pace the run to the wall clock.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     log: Annotated[Path | None, typer.Option(help="Write the per-tick log (CSV).")] = None,
@@ -74,7 +77,7 @@ def simulate(
                               laps=laps, timing=timing, predict_accel=predict_accel,
                               predict_speed_error=predict_speed_error,
                               predict_horizon=predict_horizon,
-                              reverse=reverse).settings(realtime=realtime)
+                              reverse=reverse, steering=steering).settings(realtime=realtime)
         problem = core.compile_problem(core.load_scenario(scenario))
         for name, out in (("--log", log), ("--raceline", raceline)):
             if out is not None and not out.parent.is_dir():

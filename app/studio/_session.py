@@ -30,7 +30,7 @@ import tracks
 from app.studio._clock import SceneClock
 from app.studio._compare import comparison_csv, comparison_png
 from app.studio._edit import Editor
-from app.studio._panel import build_panel
+from app.studio._panel import STEERINGS, build_panel
 from app.studio._planner_run import PlannerRun
 from app.studio._projector import Projector
 from app.studio._scene import ground_point
@@ -217,9 +217,10 @@ class Session:
         self.fit_view()
 
     def _simulate(self) -> None:
-        """`Simulate`: the planner's own run is reset out of the simulation's way."""
+        """`Simulate` with the planner panel's steering: the planner's own run is reset out of
+        the simulation's way."""
         try:
-            settings = self.sim.settings()
+            settings = self.sim.settings(STEERINGS[self.ui.steering.value])
         except ValueError as exc:
             self.notify("Simulation settings", str(exc))
             return

@@ -188,13 +188,14 @@ class SimView:
                        "events": 0}
 
     # -- commands ------------------------------------------------------------------------------
-    def settings(self) -> SimSettings:
-        """The folder's settings, within the limits of `trackstar simulate` (one ValueError
-        line naming the field when not)."""
+    def settings(self, steering: str) -> SimSettings:
+        """The folder's settings and the planner panel's ``steering``, within the limits of
+        `trackstar simulate` (one ValueError line naming the field when not)."""
         u = self.ui
         try:
             options = SimOptions(rate=float(u.rate.value), controller=u.controller.value,
-                                 noise=float(u.noise.value), seed=int(u.seed.value))
+                                 noise=float(u.noise.value), seed=int(u.seed.value),
+                                 steering=steering)
         except ValidationError as exc:
             raise ValueError(describe(exc)) from None
         return dataclasses.replace(options.settings(), realtime=True)

@@ -25,6 +25,7 @@ from planner.rrt import Planner
 from planner.sim.control import Reference
 from planner.sim.predict import Lanes, Uncertainty, predicted_world
 from planner.sim.sensing import Sensing, known_motions
+from planner.steering import STEERINGS
 from planner.timing import fastest_schedule
 
 __all__ = ["Cycle", "Replanner", "warm_up"]
@@ -151,6 +152,8 @@ class Replanner:
         s_c = min(s_now + commit, ref.length)
         if self.attached and self.planner is not None:
             s_c = max(s_c, self.root_s)  # never behind the tree's root (the last commit)
+            if STEERINGS[self.options.steering].continuous:  # where κ = 0, as at every root
+                s_c = self.root_s + self.planner.rest_from(s_c - self.root_s)
             pose, anchor, skip = self.planner.best_path_at(s_c - self.root_s)
             return pose, anchor, skip, s_c
         return tuple(ref.point_at(s_c)[:3]), -1, 0.0, s_c

@@ -19,6 +19,7 @@ import numpy as np
 from planner._goal import in_goal, in_goal_rows
 from planner._world import clearance, inflated, path_clearances
 from planner.options import TIMINGS, PlanOptions
+from planner.steering import DEFAULT_STEERING, STEERINGS
 from planner.problem import Problem, compile_problem, resolve_track
 from planner.rrt import warm_up
 from planner.scenario import Scenario
@@ -71,6 +72,7 @@ class SimSettings:
     predict_speed_error: float | None = None  # m/s: error of a sensed velocity
     predict_horizon: float | None = None  # s over which the predictions widen
     reverse: bool = True  # the car may back up to evade
+    steering: str = DEFAULT_STEERING  # the replanner's (`planner.STEERINGS`); not a robot's
 
     def uncertainty(self, scenario: Scenario | None = None) -> Uncertainty:
         """The prediction's parameters: these settings', else the scenario's, else defaults."""
@@ -90,6 +92,10 @@ class SimSettings:
                                  f"got {v}")
         if self.timing not in TIMINGS:
             raise ValueError(f"--timing must be one of {', '.join(TIMINGS)}, got {self.timing!r}")
+        car = [name for name, s in STEERINGS.items() if not s.heading_free]
+        if self.steering not in car:
+            raise ValueError(f"--steering must be one of {', '.join(car)} (the simulated car "
+                             f"cannot turn on the spot), got {self.steering!r}")
         if self.controller not in CONTROLLERS:
             raise ValueError(f"unknown controller '{self.controller}' "
                              f"(use one of {', '.join(CONTROLLERS)})")
@@ -238,6 +244,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     def new_replanner() -> Replanner:
         # No polishing: a cycle's budget is a few milliseconds, and the next cycle replans.
         return Replanner(problem, PlanOptions(seed=s.seed, polish=False, timing=s.timing,
+                                              steering=s.steering,
                                               speed=cruise if fsm is None else None),
                          seed=s.seed,
                          budget_s=s.budget_share / s.rate,
