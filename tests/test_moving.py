@@ -22,9 +22,9 @@ def straight_line(scn, speed, step=0.01):
                             s * length / speed])
 
 
-def plan(scn, iterations=3000, seed=0):
+def plan(scn, iterations=3000, seed=0, steering="dubins"):
     return planner.solve(planner.parse_scenario(scn), time_limit=None, iterations=iterations,
-                         seed=seed)
+                         seed=seed, steering=steering)
 
 
 def test_crossing_straight_line_first_touches_the_disc_at_8_s():
@@ -107,8 +107,8 @@ movers = st.lists(st.tuples(st.floats(3, 17), st.floats(1, 9), st.floats(0.3, 1.
 
 
 @settings(max_examples=12, deadline=None)
-@given(movers, st.integers(0, 1000))
-def test_random_moving_scenarios_give_paths_valid_in_space_time(obs, seed):
+@given(movers, st.integers(0, 1000), st.sampled_from(["dubins", "cc-dubins"]))
+def test_random_moving_scenarios_give_paths_valid_in_space_time(obs, seed, steering):
     scn = {"name": "random", "bounds": [0, 0, 20, 10],
            "vehicle": {"wheelbase": 0.44, "max_steer_deg": 26, "radius": 0.2, "speed": 1.5},
            "start": [1, 5, 0], "goal": [19, 5, 0], "obstacles": []}
@@ -117,6 +117,6 @@ def test_random_moving_scenarios_give_paths_valid_in_space_time(obs, seed):
             continue
         scn["obstacles"].append({"type": "circle", "center": [cx, cy], "radius": r,
                                  "motion": {"velocity": [vx, vy]}})
-    result = plan(scn, iterations=1500, seed=seed)
+    result = plan(scn, iterations=1500, seed=seed, steering=steering)
     if result.solved:
         assert first_collision(scn, result.path[:, [0, 1, 2, 5]]) is None
