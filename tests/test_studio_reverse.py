@@ -103,7 +103,8 @@ def test_the_profiles_shade_the_reverse_stretches_and_mark_the_cusps(parked, ser
     problem, live = parked
     path, vehicle = live.best_path, problem.scenario.vehicle
     profiles = Profiles(server.gui, np.linspace(0, 20, 50), np.zeros(50), 10.0,
-                        vehicle.wheelbase, vehicle.max_steer_deg, raceline_limits(vehicle=vehicle))
+                        vehicle.wheelbase, vehicle.max_steer_deg, vehicle.max_steer_rate_deg_s,
+                        raceline_limits(vehicle=vehicle))
     assert "bang-bang" in profiles.caption.content  # Dubins until told otherwise
     profiles.set_steering("reeds-shepp")
     assert "reverse" in profiles.caption.content and "cusp" in profiles.caption.content

@@ -340,6 +340,8 @@ def test_the_vehicle_folder_reads_back_the_scenario_car_and_keeps_what_it_does_n
     disc = vehicle_from_fields(base, dict(fields, footprint="disc", radius=0.1, wheelbase=0.25))
     assert disc["radius"] == 0.1 and "footprint" not in disc and disc["max_accel"] == 2.0
     assert "min_turning_radius" not in disc  # it would overrule the new wheelbase
+    servo = vehicle_from_fields(base, dict(fields, max_steer_rate_deg_s=60.0))
+    assert servo == dict(base, max_steer_rate_deg_s=60.0)  # what CC-Dubins plans with
 
 
 @pytest.mark.parametrize(("change", "message"), [
@@ -348,6 +350,7 @@ def test_the_vehicle_folder_reads_back_the_scenario_car_and_keeps_what_it_does_n
     ({"footprint": "rectangle", "length": 5.0, "width": 0.01}, "needs 500 discs"),
     ({"safety_margin": -1.0}, "safety_margin: Input should be greater than or equal to 0"),
     ({"max_steer_deg": 90.0}, "max_steer_deg: Input should be less than 90"),
+    ({"max_steer_rate_deg_s": 0.0}, "max_steer_rate_deg_s: Input should be greater than 0"),
 ])
 def test_the_vehicle_folder_refuses_what_the_scenario_model_refuses(change, message):
     from app.studio._vehicle import fields_of, vehicle_from_fields
@@ -585,15 +588,15 @@ def test_pinned_runs_keep_their_colours_and_the_comparison_has_a_row_and_curves_
     gui = SimpleNamespace(add_uplot=lambda data, series, **k: charts.append(
         SimpleNamespace(data=data, series=series)) or charts[-1],
                           add_markdown=lambda content: SimpleNamespace(content=content))
-    profiles = Profiles(gui, np.linspace(0, 14, 50), np.zeros(50), 10.0, 0.44, 26.0,
+    profiles = Profiles(gui, np.linspace(0, 14, 50), np.zeros(50), 10.0, 0.44, 26.0, 180.0,
                         raceline_limits(vehicle=problem.scenario.vehicle))
     profiles.show_path(star.path)
     profiles.show_cost(star)
     profiles.set_pins(pins.runs)
-    curvature, steering, _, cost = charts
-    for chart in (curvature, steering, cost):
+    curvature, steering, rate, _, cost = charts
+    for chart in (curvature, steering, rate, cost):
         assert [s["label"] for s in chart.series[-2:]] in (
-            [f"pin 1{x}", f"pin 2{x}"] for x in (" κ", " δ", ""))
+            [f"pin 1{x}", f"pin 2{x}"] for x in (" κ", " δ", " dδ/dt", ""))
         assert len(chart.series) == len(chart.data)
         assert len({len(d) for d in chart.data}) == 1
         assert not any(np.isnan(d[0]) for d in chart.data[1:])

@@ -23,6 +23,7 @@ APPLYING = "Applying this car…"
 def fields_of(vehicle: Vehicle) -> dict:
     """The folder's values for ``vehicle`` (a disc car keeps the panel's rectangle as is)."""
     fields = {"wheelbase": vehicle.wheelbase, "max_steer_deg": vehicle.max_steer_deg,
+              "max_steer_rate_deg_s": vehicle.max_steer_rate_deg_s,
               "footprint": "disc" if vehicle.footprint is None else "rectangle",
               "radius": vehicle.radius, "speed": vehicle.speed,
               "safety_margin": vehicle.safety_margin}
@@ -39,6 +40,9 @@ def vehicle_from_fields(base: dict, fields: dict) -> dict:
     out = {k: v for k, v in base.items() if k not in ("radius", "footprint")}
     out.update({k: float(fields[k]) for k in ("wheelbase", "max_steer_deg", "speed",
                                               "safety_margin")})
+    rate = float(fields["max_steer_rate_deg_s"])
+    if rate != base.get("max_steer_rate_deg_s", Vehicle.model_fields["max_steer_rate_deg_s"].default):
+        out["max_steer_rate_deg_s"] = rate  # the scenario's, or its default, stays implicit
     steering = (base.get("wheelbase"), base.get("max_steer_deg"))
     if steering != (out["wheelbase"], out["max_steer_deg"]):
         out.pop("min_turning_radius", None)
