@@ -71,10 +71,10 @@ def _turn(g, ax, ay, ath, bx, by, bth, d):
     chord = math.hypot(bx - ax, by - ay)
     if delta < _TINY:
         return chord, _STRAIGHT, 0.0
-    two = 2.0 * delta_min
-    arc = (delta - two if delta >= two else _TWO_PI + delta - two) / kappa
-    default = 2.0 * lmin + arc
-    if delta < two and delta < _ELEMENTARY_MAX and chord > _TINY:
+    # The arc turns what the clothoids leave of δ, once round more where they turn further
+    # (as they do for 2δmin > 2π: a servo so slow that each clothoid spirals).
+    default = 2.0 * lmin + mod2pi(delta - 2.0 * delta_min) / kappa
+    if delta < 2.0 * delta_min and delta < _ELEMENTARY_MAX and chord > _TINY:
         s0 = 4.0 * math.pi * _d1(0.5 * delta) ** 2 / (chord * chord)
         length = 2.0 * math.sqrt(delta / s0)
         if s0 <= sigma * (1.0 + 1e-9) and length < default:

@@ -140,7 +140,7 @@ def bang_bang_kin(steering):
 
 @pytest.mark.parametrize("steering", continuous, ids=[s.name for s in continuous])
 @settings(max_examples=150, deadline=None)
-@given(q0=pose, q1=pose, sigma=st.floats(0.3, 50.0))
+@given(q0=pose, q1=pose, sigma=st.floats(0.01, 50.0))
 def test_cc_paths_are_never_shorter_than_bang_bang_ones_and_keep_the_limits_as_rows(
         steering, q0, q1, sigma):
     """Every row of a CC path keeps |κ| ≤ 1/ρ and changes κ by at most σmax × the chord to
@@ -160,6 +160,8 @@ def test_cc_paths_are_never_shorter_than_bang_bang_ones_and_keep_the_limits_as_r
     assert np.all(np.abs(np.diff(rows[:, 3])) <= sigma * chords + 1e-9)
     assert rows[0, 3] == 0.0 and abs(rows[-1, 3]) < 1e-9
     assert rows[-1, :2] == pytest.approx(q1[:2], abs=1e-9)
+    if not steering.reverses:  # a servo so slow that each clothoid spirals round, too
+        assert np.all(lens >= 0.0)
 
 
 @pytest.mark.parametrize("steering", continuous, ids=[s.name for s in continuous])
