@@ -6,8 +6,10 @@ interpolating every column linearly. On a curve whose curvature is at most 1/ρ,
 piece of arc length L lies within L²/(8ρ) (its sagitta) of the curve at the same share of the way
 along both, and on an arc the heading turns evenly, as the interpolation turns it. So the
 footprint on the chord is the footprint on the curve moved by at most the sagitta, and a plan
-whose checks keep that much clearance beyond its margin (`chord_sag`) is valid as written.
-`polyline_clearance` measures what a consumer sees.
+whose checks keep that much clearance beyond its margin (`chord_sag`) is valid as written. On a
+clothoid the heading turns unevenly, and a footprint point away from the pose moves by its
+distance times the heading's error too (`heading_sag`). `polyline_clearance` measures what a
+consumer sees.
 """
 
 from __future__ import annotations
@@ -16,8 +18,8 @@ import numpy as np
 
 from planner._world import REACH, World, least_clearance
 
-__all__ = ["CHECK_M", "CHECK_S", "SPACING_M", "chord_sag", "chord_sharpness", "polyline",
-           "polyline_clearance"]
+__all__ = ["CHECK_M", "CHECK_S", "SPACING_M", "chord_sag", "chord_sharpness", "heading_sag",
+           "polyline", "polyline_clearance"]
 
 SPACING_M = 0.05  # m between rows, at most (docs/scenario-format.md)
 CHECK_M, CHECK_S = 0.005, 0.01  # returned paths are re-checked every 5 mm (and 10 ms of a wait)
@@ -27,6 +29,13 @@ def chord_sag(rho: float, spacing: float = SPACING_M) -> float:
     """The farthest a chord between rows ``spacing`` m apart on arcs of radius ``rho`` strays
     from the arc: ρ(1 − cos(L/2ρ)) ≤ L²/(8ρ)."""
     return spacing * spacing / (8.0 * rho)
+
+
+def heading_sag(sigma: float, reach: float, spacing: float = SPACING_M) -> float:
+    """The farthest a footprint point ``reach`` m from the pose strays between rows
+    ``spacing`` m apart on a clothoid of sharpness ``sigma``: there the heading is quadratic in
+    the distance, and off its linear interpolation by at most σL²/8 (on an arc, by nothing)."""
+    return reach * sigma * spacing * spacing / 8.0
 
 
 def chord_sharpness(sigma: float, rho: float, spacing: float = SPACING_M) -> float:

@@ -18,9 +18,9 @@ from planner import _kernel as K
 from planner._paths import TURN, advance, path_buffers, pose_at, rest_points, sample_path
 from planner._reroot import reroot
 from planner._rng import seed_state
-from planner._rows import SPACING_M, chord_sag, chord_sharpness, polyline_clearance
+from planner._rows import SPACING_M, chord_sag, chord_sharpness, heading_sag, polyline_clearance
 from planner._steer import steer_path
-from planner._world import World, inflated
+from planner._world import REACH, World, inflated
 from planner.options import METRICS, PlanOptions
 from planner.problem import Problem, check_room
 from planner.steering import DEFAULT_STEERING, STEERINGS
@@ -90,7 +90,7 @@ class Planner:
         s = self.options
         if s.safety_margin > problem.margin:
             check_room(problem, s.safety_margin)
-        self._world = checked_world(problem.world, problem.rho, s)
+        self._world = checked_world(problem.world, problem, s)
         steering = STEERINGS[s.steering]
         xmin, ymin, xmax, ymax = problem.bounds
         diag = math.hypot(xmax - xmin, ymax - ymin)
@@ -473,12 +473,17 @@ def _named(ev: K.Events) -> TreeEvents:
         _near=ev.near[:n_near].copy(), _near_span=ints([K.EV_NEAR_START, K.EV_NEAR_END]))
 
 
-def checked_world(world: World, rho: float, options: PlanOptions) -> World:
-    """The world as a planner with (resolved) ``options`` checks it: the footprint grown by the
-    safety margin and, for a steering that drives arcs, by the sag of the returned rows' chords
-    (`planner._rows`), so that a path is valid as written."""
-    curved = STEERINGS[options.steering].curved
-    return inflated(world, options.safety_margin + (chord_sag(rho) if curved else 0.0))
+def checked_world(world: World, problem: Problem, options: PlanOptions) -> World:
+    """``world`` (``problem``'s, or the part of it checked) as a planner with (resolved)
+    ``options`` checks it: the footprint grown by the safety margin and, for a steering that
+    drives arcs, by the sag of the returned rows' chords, and for one that drives clothoids
+    also by the sag of their linearly interpolated headings (`planner._rows`), so that a path
+    is valid as written."""
+    steering = STEERINGS[options.steering]
+    grow = options.safety_margin + (chord_sag(problem.rho) if steering.curved else 0.0)
+    if steering.continuous:
+        grow += heading_sag(problem.sharpness(options.speed), float(world.geo[REACH]))
+    return inflated(world, grow)
 
 
 _warm = False

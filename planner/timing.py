@@ -140,7 +140,7 @@ class TimeOptimalPlanner:
         static = dataclasses.replace(problem, world=without_movers(problem.world), timed=False)
         self.route = Planner(static, options)
         self.detour = Planner(problem, options) if problem.timed else None
-        self._movers = checked_world(problem.world, problem.rho, self.route.options)
+        self._movers = checked_world(problem.world, problem, self.route.options)
 
     @property
     def planners(self) -> list[Planner]:

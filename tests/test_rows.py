@@ -129,3 +129,23 @@ def test_the_least_clearance_measures_few_rows_and_is_every_rows_least(obstacles
     rows = np.vstack([[5.0, 5.0, 0.0], np.array(walk)]).cumsum(axis=0)
     rows = np.column_stack([rows, np.zeros((len(rows), 3))])
     assert least_clearance(world, rows, False) == path_clearances(world, rows, False).min()
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(-1.1, 1.1), st.floats(-20.0, 20.0), st.floats(0.01, 0.05), st.floats(0.0, 1.0))
+def test_a_clothoids_chord_and_interpolated_heading_stay_within_the_two_sags(k0, sigma, length,
+                                                                             reach):
+    """Between two rows on a clothoid a footprint point ``reach`` m ahead of the pose, moved
+    along the chord with the heading interpolated linearly, is within chord_sag + heading_sag of
+    where it is on the curve."""
+    from planner._clothoid import clothoid_pose
+    from planner._rows import heading_sag
+
+    assume(abs(k0 + sigma * length) <= 1.1)
+    u = np.linspace(0.0, 1.0, 41)
+    exact = np.array([clothoid_pose(0.0, 0.0, 0.0, k0, sigma, v * length) for v in u])
+    end = exact[-1]
+    chord = np.column_stack([u * end[0], u * end[1], u * end[2]])
+    ahead = lambda p: p[:, :2] + reach * np.column_stack([np.cos(p[:, 2]), np.sin(p[:, 2])])
+    gap = np.hypot(*(ahead(exact) - ahead(chord)).T).max()
+    assert gap <= chord_sag(1 / 1.1, length) + heading_sag(abs(sigma), reach, length) + 1e-12
