@@ -183,11 +183,12 @@ def _state(decision: Decision | None, waiting: bool) -> str:
 def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertainty,
             lanes: Lanes | None, s: SimSettings,
             limits: Limits, state, ref: Reference | None, stop_s: float, cruise: float,
-            commit: float, stuck: bool, done_s: float, agility: Agility) -> Decision:
+            commit: float, stuck: bool, done_s: float, agility: Agility,
+            known: np.ndarray) -> Decision:
     """The guard's decision at a cycle's start, in the world the car believes in now (grown
     predictions, the planning margin; the bare car where it already is inside the margin),
-    the car at rest before a mover that turns at once could reach it (`reach_world`)."""
-    known = known_motions(problem.scenario)
+    the car at rest before a mover that turns at once could reach it (`reach_world`).
+    ``known``: per motion, whether its timetable is known (`known_motions`)."""
     believed = predicted_world(problem.world, sensing, t, uncertainty, known, lanes)
     reach = reach_world(problem.world, sensing, t, agility, uncertainty, known, lanes)
     margin = GUARD_MARGIN * s.margin
@@ -313,7 +314,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                                    ref, stop_s, cruise, lead,
                                    backing or (not backed_off
                                                and t - planless_since >= STUCK_S), done_s,
-                                   agility)
+                                   agility, known)
                 decided_at = t
                 if decision.manoeuvre.name == BACK_OFF and not backing:
                     backed_at, backed_off = t, True  # once, until the car drives on again
