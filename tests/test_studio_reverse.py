@@ -106,6 +106,9 @@ def test_the_profiles_shade_the_reverse_stretches_and_mark_the_cusps(parked, ser
                         vehicle.wheelbase, vehicle.max_steer_deg, vehicle.max_steer_rate_deg_s,
                         raceline_limits(vehicle=vehicle))
     assert "bang-bang" in profiles.caption.content  # Dubins until told otherwise
+    profiles.set_steering("dubins", "cc-dubins")  # the split: both, named
+    assert "**A, Dubins:**" in profiles.caption.content
+    assert "**B, CC-Dubins:**" in profiles.caption.content and "ramp" in profiles.caption.content
     profiles.set_steering("reeds-shepp")
     assert "reverse" in profiles.caption.content and "cusp" in profiles.caption.content
     profiles.show_path(path)

@@ -194,9 +194,15 @@ class Profiles:
     def handles(self) -> tuple:
         return self.caption, self.curvature, self.steering, self.rate, self.speed, self.cost
 
-    def set_steering(self, name: str) -> None:
-        """The caption for paths of this steering (`planner.STEERINGS`' names)."""
-        self.caption.content = STEERINGS[name].curvature
+    def set_steering(self, name: str, b: str | None = None) -> None:
+        """The caption for paths of this steering (`planner.STEERINGS`' names) and, in the
+        split, for run B's where it is another."""
+        a = STEERINGS[name]
+        if b is None or b == name:
+            self.caption.content = a.curvature
+            return
+        self.caption.content = (f"**A, {a.label}:** {a.curvature}\n\n"
+                                f"**B, {STEERINGS[b].label}:** {STEERINGS[b].curvature}")
 
     @property
     def _others(self) -> list:
