@@ -24,11 +24,11 @@ from typing import NamedTuple
 
 import numpy as np
 
+from planner._cc_dubins import cc_constants
 from planner._dubins import turning_centres
 from planner._goal import in_goal
 from planner._jit import njit
 from planner._paths import path_buffers, path_end, truncate, wrap_angle
-from planner._cc_dubins import cc_constants
 from planner._polish import PASSES, polish_path
 from planner._rng import uniform
 from planner._steer import (

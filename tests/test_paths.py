@@ -4,10 +4,10 @@ import math
 
 import numpy as np
 import pytest
+from _arcs import arcs
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from _arcs import arcs
 from planner._paths import (
     MIN_SEGMENT,
     path_buffers,

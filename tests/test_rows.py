@@ -146,6 +146,9 @@ def test_a_clothoids_chord_and_interpolated_heading_stay_within_the_two_sags(k0,
     exact = np.array([clothoid_pose(0.0, 0.0, 0.0, k0, sigma, v * length) for v in u])
     end = exact[-1]
     chord = np.column_stack([u * end[0], u * end[1], u * end[2]])
-    ahead = lambda p: p[:, :2] + reach * np.column_stack([np.cos(p[:, 2]), np.sin(p[:, 2])])
+
+    def ahead(p):
+        return p[:, :2] + reach * np.column_stack([np.cos(p[:, 2]), np.sin(p[:, 2])])
+
     gap = np.hypot(*(ahead(exact) - ahead(chord)).T).max()
     assert gap <= chord_sag(1 / 1.1, length) + heading_sag(abs(sigma), reach, length) + 1e-12

@@ -16,8 +16,8 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from planner import STEERINGS, PlanOptions
-from planner._paths import path_buffers, path_end, path_length, pose_at, sample_path
 from planner._cc_dubins import cc_constants
+from planner._paths import path_buffers, path_end, path_length, pose_at, sample_path
 from planner._steer import state, steer_bound, steer_length, steer_path, steer_tight_bound
 
 RHO, SIGMA = 0.9, 3.0  # σ: a servo of 150°/s on a 0.4 m wheelbase at 1.25 m/s

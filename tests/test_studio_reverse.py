@@ -4,6 +4,7 @@ that reverses into the slot, and what the studio draws of it — scene, profiles
 
 from __future__ import annotations
 
+import math
 import re
 import time
 from types import SimpleNamespace
@@ -106,9 +107,12 @@ def test_the_profiles_shade_the_reverse_stretches_and_mark_the_cusps(parked, ser
                         vehicle.wheelbase, vehicle.max_steer_deg, vehicle.max_steer_rate_deg_s,
                         raceline_limits(vehicle=vehicle))
     assert "bang-bang" in profiles.caption.content  # Dubins until told otherwise
-    profiles.set_steering("dubins", "cc-dubins")  # the split: both, named
+    profiles.set_steering("dubins", "cc-dubins", 7.0)  # the split: both, named
     assert "**A, Dubins:**" in profiles.caption.content
     assert "**B, CC-Dubins:**" in profiles.caption.content and "ramp" in profiles.caption.content
+    kmax = math.tan(math.radians(vehicle.max_steer_deg)) / vehicle.wheelbase
+    assert f"σmax = 7 1/m²: from straight to full lock takes {kmax / 7:.2g} m" \
+        in profiles.caption.content
     profiles.set_steering("reeds-shepp")
     assert "reverse" in profiles.caption.content and "cusp" in profiles.caption.content
     profiles.show_path(path)

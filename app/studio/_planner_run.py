@@ -175,8 +175,9 @@ class PlannerRun:
         self.ui.extend.content = render(None, FIRST_NOTE, star=options.planner == "rrtstar")
         self._show_pins_legend()
         if self._profiles is not None:
-            self._profiles.set_steering(options.steering,
-                                        other.steering if other is not None else None)
+            self._profiles.set_steering(
+                options.steering, other.steering if other is not None else None,
+                problem.sharpness(options.speed or problem.speed))
             self._profiles.show_path(np.zeros((0, 4)), self.current_b())
             self._profiles.show_cost(*self._compared_now())
 

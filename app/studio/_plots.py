@@ -172,7 +172,8 @@ class Profiles:
             title="Steering δ (deg) vs s (m)", **common)
         self.rate = gui.add_uplot(
             rate, (_series("s (m)"), _series("path dδ/dt", CURRENT, 2.0),
-                   _series("+servo", "#2e9e5b", 1, [4, 4]), _series("−servo", "#2e9e5b", 1, [4, 4])),
+                   _series("+servo", "#2e9e5b", 1, [4, 4]),
+                   _series("−servo", "#2e9e5b", 1, [4, 4])),
             title="Steering rate dδ/dt (deg/s) vs s (m), as driven",
             **common | {"bands": ({"series": (2, 3), "fill": "rgba(80,200,120,0.12)"},),
                         "scales": NUMERIC_X | {"y": {"range": [-2 * self._rmax, 2 * self._rmax]}}})
@@ -194,15 +195,23 @@ class Profiles:
     def handles(self) -> tuple:
         return self.caption, self.curvature, self.steering, self.rate, self.speed, self.cost
 
-    def set_steering(self, name: str, b: str | None = None) -> None:
+    def set_steering(self, name: str, b: str | None = None, sigma: float = math.inf) -> None:
         """The caption for paths of this steering (`planner.STEERINGS`' names) and, in the
-        split, for run B's where it is another."""
+        split, for run B's where it is another; a continuous-curvature one's says what its
+        sharpness ``sigma`` (σmax, 1/m²) makes of a turn."""
+
+        def said(steering) -> str:
+            if not steering.continuous or not math.isfinite(sigma):
+                return steering.curvature
+            return (f"{steering.curvature} Here σmax = {sigma:.3g} 1/m²: from straight to full "
+                    f"lock takes {self._kmax / sigma:.2g} m.")
+
         a = STEERINGS[name]
         if b is None or b == name:
-            self.caption.content = a.curvature
+            self.caption.content = said(a)
             return
-        self.caption.content = (f"**A, {a.label}:** {a.curvature}\n\n"
-                                f"**B, {STEERINGS[b].label}:** {STEERINGS[b].curvature}")
+        self.caption.content = (f"**A, {a.label}:** {said(a)}\n\n"
+                                f"**B, {STEERINGS[b].label}:** {said(STEERINGS[b])}")
 
     @property
     def _others(self) -> list:

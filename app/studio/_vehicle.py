@@ -41,7 +41,8 @@ def vehicle_from_fields(base: dict, fields: dict) -> dict:
     out.update({k: float(fields[k]) for k in ("wheelbase", "max_steer_deg", "speed",
                                               "safety_margin")})
     rate = float(fields["max_steer_rate_deg_s"])
-    if rate != base.get("max_steer_rate_deg_s", Vehicle.model_fields["max_steer_rate_deg_s"].default):
+    default = Vehicle.model_fields["max_steer_rate_deg_s"].default
+    if rate != base.get("max_steer_rate_deg_s", default):
         out["max_steer_rate_deg_s"] = rate  # the scenario's, or its default, stays implicit
     steering = (base.get("wheelbase"), base.get("max_steer_deg"))
     if steering != (out["wheelbase"], out["max_steer_deg"]):

@@ -19,7 +19,6 @@ import numpy as np
 from planner._goal import in_goal, in_goal_rows
 from planner._world import clearance, inflated, path_clearances
 from planner.options import TIMINGS, PlanOptions
-from planner.steering import DEFAULT_STEERING, STEERINGS
 from planner.problem import Problem, compile_problem, resolve_track
 from planner.rrt import warm_up
 from planner.scenario import Scenario
@@ -41,6 +40,7 @@ from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
 from planner.sim.sensing import Sensing, known_motions, mover_index, sense, true_offsets
 from planner.sim.vehicle import Limits, arc_step, limit_commands
+from planner.steering import DEFAULT_STEERING, STEERINGS
 from planner.timing import warm_up as warm_up_timing
 from planner.tree import TreeSnapshot
 
