@@ -312,9 +312,10 @@ def _metric(metric, code, a, b, g, bound) -> float:
 
 
 @njit(cache=True)
-def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
+def nearest(tree: Tree, P: np.ndarray, g, qx, qy, qth):
     """(node, distance) of the tree node nearest to the query pose by the metric: the
-    shortest car path (steering length) or se2.
+    shortest car path (steering length) or se2; ``g``: the car's turning constants
+    (`turning`, computed once per `iterate`).
 
     Best first: grid rings are opened outward and their nodes filed by a lower bound of their
     path length into buckets half a cell wide; exact lengths are computed bucket by bucket,
@@ -325,7 +326,7 @@ def nearest(tree: Tree, P: np.ndarray, qx, qy, qth):
     tighter `steer_tight_bound` and is filed again (key −1 − bound) if that moves it up: poses
     facing back at the tree pass the turning circles' bound by the hundred on a small track.
     """
-    code, g, metric = int(P[STEERING]), turning(P), int(P[METRIC])
+    code, metric = int(P[STEERING]), int(P[METRIC])
     to = state(qx, qy, qth, math.cos(qth), math.sin(qth), g[0])
     nx, ny, cell = int(tree.grid[3]), int(tree.grid[4]), tree.grid[2]
     ci, cj = _cell(tree, qx, qy)
@@ -622,8 +623,8 @@ def _update_best(tree: Tree) -> None:
 
 
 @njit(cache=True)
-def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, kinds, lens,
-                   curv, pk, pl, pc, counter):
+def _choose_parent(tree: Tree, w: World, P, g, m, x, y, th, radius, c_new, parent, kinds,
+                   lens, curv, pk, pl, pc, counter):
     """Cheapest collision-free parent among the near candidates, best first.
 
     Candidates enter a min-heap keyed by cost(j) + a lower bound of their path to x_new; a
@@ -633,7 +634,7 @@ def _choose_parent(tree: Tree, w: World, P, m, x, y, th, radius, c_new, parent, 
     leaves the winning edge in kinds/lens/curv (pk/pl/pc: scratch).
     """
     keys, vals = tree.near_key, tree.stack
-    code, g = int(P[STEERING]), turning(P)
+    code = int(P[STEERING])
     to = state(x, y, th, math.cos(th), math.sin(th), g[0])
     size = 0
     for q in range(m):
@@ -709,7 +710,7 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
             # counts as an iteration: OMPL's RRT* spends a nearest search and a failed
             # motion check on it).
             continue
-        near_i, dist = nearest(tree, P, xr, yr, thr)
+        near_i, dist = nearest(tree, P, g, xr, yr, thr)
         nx0, ny0, nth0 = tree.pose[near_i, 0], tree.pose[near_i, 1], tree.pose[near_i, 2]
         thr = arrival_heading(code, nx0, ny0, nth0, xr, yr, thr)
         length = steer_path(code, nx0, ny0, nth0, xr, yr, thr, g, kinds, lens, curv)
@@ -761,7 +762,7 @@ def iterate(tree: Tree, w: World, P: np.ndarray, n_iter: int, ev: Events) -> int
             else:
                 radius = min(P[GAMMA] * (math.log(n) / n) ** (1.0 / P[DIMS]), P[EPS])
                 m = _near(tree, x, y, radius, 0)
-            c_new, parent = _choose_parent(tree, w, P, m, x, y, th, radius, c_new, parent,
+            c_new, parent = _choose_parent(tree, w, P, g, m, x, y, th, radius, c_new, parent,
                                            kinds, lens, curv, scratch_k, scratch_l, scratch_c,
                                            counter)
             if parent < 0:

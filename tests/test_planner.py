@@ -191,7 +191,7 @@ def test_nearest_is_the_true_nearest_by_steering_length(name, steering):
     xmin, ymin, xmax, ymax = problem.bounds
     for _ in range(150):
         q = (rng.uniform(xmin, xmax), rng.uniform(ymin, ymax), rng.uniform(-math.pi, math.pi))
-        node, found = K.nearest(tree, run._P, *q)
+        node, found = K.nearest(tree, run._P, K.turning(run._P), *q)
         lengths = [steer_path(code, *tree.pose[j], *q, K.turning(run._P), *path)
                    for j in range(n)]
         assert found == pytest.approx(min(lengths), abs=1e-9)
@@ -238,7 +238,7 @@ def test_the_se2_metric_picks_the_se2_nearest_and_still_plans_exact_paths():
     xmin, ymin, xmax, ymax = problem.bounds
     for _ in range(100):
         q = (rng.uniform(xmin, xmax), rng.uniform(ymin, ymax), rng.uniform(-math.pi, math.pi))
-        node, found = K.nearest(run._tree, run._P, *q)
+        node, found = K.nearest(run._tree, run._P, K.turning(run._P), *q)
         d = np.sqrt(((tree.pose[:, :2] - q[:2]) ** 2).sum(axis=1)
                     + (rho * np.remainder(q[2] - tree.pose[:, 2] + math.pi, 2 * math.pi)
                        - rho * math.pi) ** 2)
