@@ -95,6 +95,18 @@ def _wrap_pi(a: float) -> float:
     return v
 
 
+@njit(cache=True, inline="always")
+def _slack(r):
+    """Sign slack of an angle atan2(η, ξ) with r = |(ξ, η)|.
+
+    ξ and η carry absolute rounding of a few 1e-16 (1 − cos φ), so the angle's error grows as
+    1e-16/r: a path of 1e-5 ρ lost its CS word to a last arc of −1e-11 rad (hypothesis found
+    it). Accepting such a sliver is safe: the signed segments still reach the goal exactly, and
+    their absolute sum is the honest length.
+    """
+    return _ZERO + 4e-15 / max(r, 1e-300)
+
+
 @njit(cache=True)
 def _tau_omega(u, v, xi, eta, phi):
     delta = _wrap_pi(u - v)
@@ -140,9 +152,10 @@ def _lp_sp_lp(x, y, phi, sp, cp, lmin):
     if u + _turn_same(phi) >= lmin:  # t + v ≡ φ, t, v ≥ 0
         return False, 0.0, 0.0, 0.0
     t = math.atan2(eta, xi)
-    if t >= -_ZERO:
+    zero = _slack(u)
+    if t >= -zero:
         v = _wrap_pi(phi - t)
-        if v >= -_ZERO:
+        if v >= -zero:
             return True, t, u, v
     return False, 0.0, 0.0, 0.0
 
@@ -176,7 +189,7 @@ def _lp_rm_l(x, y, phi, sp, cp, lmin):
         u = -2.0 * math.asin(0.25 * r)
         t = _wrap_pi(theta + 0.5 * u + PI)
         v = _wrap_pi(phi - t + u)
-        if t >= -_ZERO and u <= _ZERO:
+        if t >= -_slack(r) and u <= _ZERO:
             return True, t, u, v
     return False, 0.0, 0.0, 0.0
 

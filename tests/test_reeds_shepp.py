@@ -309,3 +309,17 @@ def test_a_vanishing_last_arc_is_not_lost_to_rounding():
     kinds, lens = np.array([-1, 0, 0, 0, 0], np.int8), np.array([-1.5, -0.05078125, 0, 0, 0])
     goal = path_end(*start, kinds, lens, arcs(kinds, rho))
     assert length(start, goal, rho) == pytest.approx(1.55078125, abs=1e-9)
+
+
+@pytest.mark.parametrize("kinds, lens, rho", [
+    ([-1, 0, 0, 0, 0], [1.2226278902417902e-05, 1.2226278902417902e-05, 0, 0, 0], 1.5),  # CI
+    ([1, 0, 0, 0, 1], [2.29737524e-05, 0, 0, 8.44907861e-05, 0], 2.465258475099073),
+    ([-1, 1, 0, 0, 0], [0, 1.15502328e-05, 4.26458768e-05, 1.23732438e-05, 1.44023784e-06],
+     2.161829225265077),
+])
+def test_a_tiny_path_keeps_its_word(kinds, lens, rho):
+    """At 1e-5 ρ the angle atan2(η, ξ) of a CSC word is off by ~1e-11 rad, and a 1e-12 slack
+    lost the word to one 70 % longer (hypothesis found it); the slack now scales with 1/|(ξ, η)|."""
+    kinds, lens = np.array(kinds, np.int8), np.array(lens)
+    goal = path_end(0.0, 0.0, 0.0, kinds, lens, arcs(kinds, rho))
+    assert length((0.0, 0.0, 0.0), goal, rho) <= np.abs(lens).sum() + tol(rho)
