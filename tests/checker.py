@@ -320,7 +320,8 @@ def clothoid_mismatch(path) -> float:
 def schedule_errors(path, max_speed: float, rounding: float = 0.0) -> list[str]:
     """docs/scenario-format.md v1.3's rules for a timed path of ``timing: optimal``: t from 0 and
     non-decreasing, at most ``max_speed`` between entries (1 % tolerance, and ``rounding`` m
-    for rows rounded to that many metres and seconds), entries at most 0.05 m and 0.1 s apart.
+    for rows rounded to that many metres and seconds), entries at most 0.05 m and 0.1 s apart
+    (up to the rounding too).
     Returns one message per kind of breach."""
     path = np.asarray(path, dtype=float)
     step = np.hypot(*np.diff(path[:, :2], axis=0).T)
@@ -336,8 +337,8 @@ def schedule_errors(path, max_speed: float, rounding: float = 0.0) -> list[str]:
         k = int(np.argmax(fast))
         errors.append(f"entry {k} to {k + 1}: {step[k]:.4f} m in {dt[k]:.4f} s is above "
                       f"{max_speed} m/s")
-    if (step > 0.05 + 1e-9).any():
+    if (step > 0.05 + 1e-9 + 2 * rounding).any():
         errors.append(f"entries up to {step.max():.4f} m apart")
-    if (dt > 0.1 + 1e-9).any():
+    if (dt > 0.1 + 1e-9 + 2 * rounding).any():
         errors.append(f"entries up to {dt.max():.4f} s apart")
     return errors
