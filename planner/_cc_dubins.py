@@ -7,7 +7,7 @@ radius r around the arc's centre Ω, its heading there at the angle μ to the ci
 planned with these circles as Dubins paths are with circles of radius ρ: a turn, a straight
 tangent to both circles at the angle μ, and a turn (TST), or three turns (TTT).
 
-Each turn (`_turn`) deflects the heading by δ. A CC turn cannot deflect less than 2·δmin, its
+Each turn (`cc_turn`) deflects the heading by δ. A CC turn cannot deflect less than 2·δmin, its
 two clothoids' own turning (δmin = κmax²/2σ); a smaller deflection is an elementary path, two
 clothoids of a lower sharpness σ0 that meet at κ = √(δσ0) ≤ κmax, where that exists and is
 shorter than the loop round the circle (Scheuer & Fraichard 1997); no deflection is a straight.
@@ -58,14 +58,15 @@ def _d1(alpha: float) -> float:
     return math.cos(alpha) * c + math.sin(alpha) * s
 
 
-# What `_turn` found: a straight, an elementary path, or clothoid-arc-clothoid.
+# What `cc_turn` found: a straight, an elementary path, or clothoid-arc-clothoid.
 _STRAIGHT, _ELEMENTARY, _DEFAULT = range(3)
 
 
 @njit(cache=True)
-def _turn(g, ax, ay, ath, bx, by, bth, d):
-    """(length, shape, σ0) of the CC turn of direction ``d`` (+1 left, −1 right) from pose a
-    to pose b, both on one CC circle of that direction; σ0 is an elementary path's sharpness."""
+def cc_turn(g, ax, ay, ath, bx, by, bth, d):
+    """(length, shape, σ0) of the CC turn from pose a to pose b, both on one CC circle, whose
+    heading turns the way ``d`` says (+1 to the left, −1 to the right: a left turn driven
+    forward, or a right turn in reverse); σ0 is an elementary path's sharpness."""
     kappa, sigma, delta_min, lmin = g[1], g[2], g[6], g[7]
     delta = mod2pi(d * (bth - ath))
     chord = math.hypot(bx - ax, by - ay)
@@ -121,14 +122,14 @@ def _best(g, x0, y0, th0, x1, y1, th1):
                 qbx, qby = bx + r * (-smu * c - d1 * cmu * s), by + r * (-smu * s + d1 * cmu * c)
                 straight = max(math.sqrt(big_d * big_d - 4.0 * r * r * cmu * cmu)
                                - 2.0 * r * smu, 0.0)
-                length = (_turn(g, x0, y0, th0, qax, qay, th, d1)[0] + straight
-                          + _turn(g, qbx, qby, th, x1, y1, th1, d2)[0])
+                length = (cc_turn(g, x0, y0, th0, qax, qay, th, d1)[0] + straight
+                          + cc_turn(g, qbx, qby, th, x1, y1, th1, d2)[0])
                 if length < best[0]:
                     best = (length, d1, d2, 0, qax, qay, th, qbx, qby, th)
             if d1 != d2:
                 continue
             if big_d < _TINY * r:  # pose 1 ends a turn on the start circle: one turn
-                length = _turn(g, x0, y0, th0, x1, y1, th1, d1)[0]
+                length = cc_turn(g, x0, y0, th0, x1, y1, th1, d1)[0]
                 if length < best[0]:
                     best = (length, d1, d2, 0, x1, y1, th1, x1, y1, th1)
                 continue
@@ -136,8 +137,8 @@ def _best(g, x0, y0, th0, x1, y1, th1):
                 c, s = math.cos(angle), math.sin(angle)
                 qax, qay = ax + r * (smu * c + d1 * cmu * s), ay + r * (smu * s - d1 * cmu * c)
                 qbx, qby = bx + r * (-smu * c + d1 * cmu * s), by + r * (-smu * s - d1 * cmu * c)
-                length = (_turn(g, x0, y0, th0, qax, qay, angle, d1)[0] + big_d - 2.0 * r * smu
-                          + _turn(g, qbx, qby, angle, x1, y1, th1, d1)[0])
+                length = (cc_turn(g, x0, y0, th0, qax, qay, angle, d1)[0] + big_d - 2.0 * r * smu
+                          + cc_turn(g, qbx, qby, angle, x1, y1, th1, d1)[0])
                 if length < best[0]:
                     best = (length, d1, d2, 0, qax, qay, angle, qbx, qby, angle)
             if big_d <= 4.0 * r:  # TTT: a middle circle tangent to both, on either side
@@ -147,9 +148,9 @@ def _best(g, x0, y0, th0, x1, y1, th1):
                     my = ay + 0.5 * ey + side * h * ex / big_d
                     pax, pay, pth = _tangent(ax, ay, mx, my, d1, mu)
                     pbx, pby, qth = _tangent(mx, my, bx, by, -d1, mu)
-                    length = (_turn(g, x0, y0, th0, pax, pay, pth, d1)[0]
-                              + _turn(g, pax, pay, pth, pbx, pby, qth, -d1)[0]
-                              + _turn(g, pbx, pby, qth, x1, y1, th1, d1)[0])
+                    length = (cc_turn(g, x0, y0, th0, pax, pay, pth, d1)[0]
+                              + cc_turn(g, pax, pay, pth, pbx, pby, qth, -d1)[0]
+                              + cc_turn(g, pbx, pby, qth, x1, y1, th1, d1)[0])
                     if length < best[0]:
                         best = (length, d1, d2, 1, pax, pay, pth, pbx, pby, qth)
     return best
@@ -162,22 +163,25 @@ def cc_dubins_length(x0, y0, th0, x1, y1, th1, g) -> float:
 
 
 @njit(cache=True)
-def _write_turn(g, ax, ay, ath, bx, by, bth, d, kinds, lens, curv, k) -> int:
-    """Write the turn from pose a to pose b (`_turn`) from segment ``k`` on; returns the next."""
-    length, shape, s0 = _turn(g, ax, ay, ath, bx, by, bth, d)
+def write_cc_turn(g, ax, ay, ath, bx, by, bth, d, gear, kinds, lens, curv, k) -> int:
+    """Write the turn of steering direction ``d`` (+1 left) from pose a to pose b (`cc_turn`),
+    driven forward (``gear`` +1) or in reverse (−1), from segment ``k`` on; returns the next."""
+    length, shape, s0 = cc_turn(g, ax, ay, ath, bx, by, bth, d * gear)
     if shape == _STRAIGHT:
-        kinds[k], lens[k], curv[k, 0], curv[k, 1] = STRAIGHT, length, 0.0, 0.0
+        kinds[k], lens[k], curv[k, 0], curv[k, 1] = STRAIGHT, gear * length, 0.0, 0.0
         return k + 1
     if shape == _ELEMENTARY:
         half = 0.5 * length
-        kinds[k], lens[k], curv[k, 0], curv[k, 1] = d, half, 0.0, d * s0
-        kinds[k + 1], lens[k + 1], curv[k + 1, 0], curv[k + 1, 1] = d, half, d * s0 * half, -d * s0
+        kinds[k], lens[k], curv[k, 0], curv[k, 1] = d, gear * half, 0.0, d * s0
+        kinds[k + 1], lens[k + 1], curv[k + 1, 0], curv[k + 1, 1] = d, gear * half, \
+            d * s0 * half, -d * s0
         return k + 2
     kappa, sigma, lmin = g[1], g[2], g[7]
-    kinds[k], lens[k], curv[k, 0], curv[k, 1] = d, lmin, 0.0, d * sigma
-    kinds[k + 1], lens[k + 1], curv[k + 1, 0], curv[k + 1, 1] = d, length - 2.0 * lmin, \
+    kinds[k], lens[k], curv[k, 0], curv[k, 1] = d, gear * lmin, 0.0, d * sigma
+    kinds[k + 1], lens[k + 1], curv[k + 1, 0], curv[k + 1, 1] = d, gear * (length - 2.0 * lmin), \
         d * kappa, 0.0
-    kinds[k + 2], lens[k + 2], curv[k + 2, 0], curv[k + 2, 1] = d, lmin, d * kappa, -d * sigma
+    kinds[k + 2], lens[k + 2], curv[k + 2, 0], curv[k + 2, 1] = d, gear * lmin, d * kappa, \
+        -d * sigma
     return k + 3
 
 
@@ -189,11 +193,11 @@ def cc_dubins_path(x0, y0, th0, x1, y1, th1, g, kinds, lens, curv) -> float:
     kinds[:] = 0
     lens[:] = 0.0
     curv[:, :] = 0.0
-    k = _write_turn(g, x0, y0, th0, ax, ay, ath, d1, kinds, lens, curv, 0)
+    k = write_cc_turn(g, x0, y0, th0, ax, ay, ath, d1, 1.0, kinds, lens, curv, 0)
     if middle:
-        k = _write_turn(g, ax, ay, ath, bx, by, bth, -d1, kinds, lens, curv, k)
+        k = write_cc_turn(g, ax, ay, ath, bx, by, bth, -d1, 1.0, kinds, lens, curv, k)
     else:
         kinds[k], lens[k] = STRAIGHT, math.hypot(bx - ax, by - ay)
         k += 1
-    _write_turn(g, bx, by, bth, x1, y1, th1, d2, kinds, lens, curv, k)
+    write_cc_turn(g, bx, by, bth, x1, y1, th1, d2, 1.0, kinds, lens, curv, k)
     return length

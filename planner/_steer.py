@@ -15,6 +15,7 @@ bound costs a Dubins length.
 from __future__ import annotations
 
 from planner._cc_dubins import cc_dubins_length, cc_dubins_path
+from planner._cc_reeds_shepp import cc_reeds_shepp_length, cc_reeds_shepp_path
 from planner._dubins import (
     dubins_length_cs,
     dubins_lower_bound,
@@ -26,7 +27,7 @@ from planner._jit import njit
 from planner._paths import arc_curvatures, rest_points, wrap_angle
 from planner._reeds_shepp import reeds_shepp_length, reeds_shepp_lower_bound, reeds_shepp_path
 from planner._straight import straight_heading, straight_length, straight_path
-from planner.steering import CC_DUBINS, DUBINS, REEDS_SHEPP, STRAIGHT
+from planner.steering import CC_DUBINS, CC_REEDS_SHEPP, DUBINS, REEDS_SHEPP, STRAIGHT
 
 
 @njit(cache=True, inline="always")
@@ -42,6 +43,8 @@ def steer_path(code, x0, y0, th0, x1, y1, th1, g, kinds, lens, curv) -> float:
     returns its length."""
     if code == CC_DUBINS:
         return cc_dubins_path(x0, y0, th0, x1, y1, th1, g, kinds, lens, curv)
+    if code == CC_REEDS_SHEPP:
+        return cc_reeds_shepp_path(x0, y0, th0, x1, y1, th1, g, kinds, lens, curv)
     rho = g[0]
     if code == DUBINS:
         length = dubins_path(x0, y0, th0, x1, y1, th1, rho, kinds, lens)
@@ -63,8 +66,11 @@ def steer_length(code, a, b, g, bound) -> float:
         if code == DUBINS or length >= bound:
             return length
         return cc_dubins_length(a[0], a[1], a[2], b[0], b[1], b[2], g)
-    if code == REEDS_SHEPP:
-        return reeds_shepp_length(a[0], a[1], a[2], b[0], b[1], b[2], rho, bound)
+    if code == REEDS_SHEPP or code == CC_REEDS_SHEPP:
+        length = reeds_shepp_length(a[0], a[1], a[2], b[0], b[1], b[2], rho, bound)
+        if code == REEDS_SHEPP or length >= bound:
+            return length
+        return cc_reeds_shepp_length(a[0], a[1], a[2], b[0], b[1], b[2], g, bound)
     return straight_length(a[0], a[1], b[0], b[1])
 
 
@@ -75,7 +81,7 @@ def steer_bound(code, a, b, g) -> float:
     if code == DUBINS or code == CC_DUBINS:
         return dubins_lower_bound(a[5], a[6], a[7], a[8], b[5], b[6], b[7], b[8],
                                   wrap_angle(b[2] - a[2]), rho)
-    if code == REEDS_SHEPP:
+    if code == REEDS_SHEPP or code == CC_REEDS_SHEPP:
         return reeds_shepp_lower_bound(a[0], a[1], a[2], b[0], b[1], b[2], rho)
     return straight_length(a[0], a[1], b[0], b[1])
 
@@ -105,7 +111,7 @@ def steer_cut(code, kinds, lens, curv, s, beyond) -> float:
     only where its κ is 0, so that the node it ends at starts the next path with the κ it ends
     this one: at the last such point up to ``s`` or, if there is none and ``beyond``, the first
     after (0: nowhere)."""
-    if code != CC_DUBINS:
+    if code != CC_DUBINS and code != CC_REEDS_SHEPP:
         return s
     before, after = rest_points(kinds, lens, curv, s)
     return after if beyond and before <= 0.0 else before

@@ -3,8 +3,7 @@
 Every edge of the system takes its list from `STEERINGS`: the options model (`PlanOptions`),
 `trackstar plan --steering`, the REST schema, the studio's dropdown and docs. The compiled
 implementations live one per module (`_dubins.py`, `_reeds_shepp.py`, `_straight.py`,
-`_cc_dubins.py`); the
-planner's kernel reaches them through `_steer.py` by each entry's integer ``code``, and stores
+`_cc_dubins.py`, `_cc_reeds_shepp.py`); the planner's kernel reaches them through `_steer.py` by each entry's integer ``code``, and stores
 their paths in the segment form of `_paths.py`, ``segments`` wide. Adding a
 steering function is: its module, an entry here, a branch per function in `_steer.py`.
 """
@@ -17,7 +16,7 @@ from typing import Literal
 __all__ = ["DEFAULT_STEERING", "STEERINGS", "Steering", "SteeringName"]
 
 # the kernel's codes (`_steer.py` dispatches on them)
-DUBINS, REEDS_SHEPP, STRAIGHT, CC_DUBINS = range(4)
+DUBINS, REEDS_SHEPP, STRAIGHT, CC_DUBINS, CC_REEDS_SHEPP = range(5)
 
 
 @dataclass(frozen=True)
@@ -73,6 +72,13 @@ STEERINGS = {s.name: s for s in (
              "σmax, so κ(s) has ramps where Dubins has steps, and δ(s) is a steering servo's "
              "to follow; dδ/dt stays within vehicle.max_steer_rate_deg_s at the planned speed.",
              segments=9, continuous=True, shortest=False),
+    Steering("cc-reeds-shepp", "CC-Reeds-Shepp", CC_REEDS_SHEPP, True, False,
+             "forward and reverse, continuous curvature: clothoids into and out of every turn, "
+             "cusps where the wheels are straight (Fraichard & Scheuer 2004)",
+             "CC-Reeds-Shepp paths ramp κ up to ±1/ρ and back down along clothoids of "
+             "sharpness σmax, forward or in reverse, and change direction only where κ = 0: "
+             "no step anywhere, a cusp (◆) included. Shaded: driven in reverse.",
+             segments=13, continuous=True, shortest=False),
 )}
 DEFAULT_STEERING = next(iter(STEERINGS))
 

@@ -34,7 +34,7 @@ def car_outline(x, y, th, length, width, overhang):
     return shapely.Polygon([(x + c * u - s * v, y + s * u + c * v) for u, v in corners])
 
 
-@pytest.mark.parametrize("steering", ["dubins", "reeds-shepp", "cc-dubins"])
+@pytest.mark.parametrize("steering", ["dubins", "reeds-shepp", "cc-dubins", "cc-reeds-shepp"])
 def test_planned_rectangle_never_touches_an_obstacle(steering):
     data = scenario_dict("parking")
     data["vehicle"].pop("radius")

@@ -107,7 +107,7 @@ movers = st.lists(st.tuples(st.floats(3, 17), st.floats(1, 9), st.floats(0.3, 1.
 
 
 @settings(max_examples=12, deadline=None)
-@given(movers, st.integers(0, 1000), st.sampled_from(["dubins", "cc-dubins"]))
+@given(movers, st.integers(0, 1000), st.sampled_from(["dubins", "cc-dubins", "cc-reeds-shepp"]))
 def test_random_moving_scenarios_give_paths_valid_in_space_time(obs, seed, steering):
     scn = {"name": "random", "bounds": [0, 0, 20, 10],
            "vehicle": {"wheelbase": 0.44, "max_steer_deg": 26, "radius": 0.2, "speed": 1.5},

@@ -180,17 +180,19 @@ def test_the_first_plan_is_not_a_replan():
     assert s["cycles"] >= 1 and s["replans"] == 0
 
 
-def test_a_continuous_curvature_lap_is_tracked_closer_than_a_dubins_one(tmp_path):
+@pytest.mark.parametrize("steering", ["dubins", "reeds-shepp"])
+def test_a_continuous_curvature_lap_is_tracked_closer_than_a_bang_bang_one(tmp_path, steering):
     """The thesis's PD feeds the plan's curvature forward as δ = atan(Lκ): a servo at
-    max_steer_rate cannot follow a Dubins path's steps and the car drifts off (about 0.12 m,
-    into a wall here), while it follows a CC-Dubins path's ramps (issue 36)."""
+    max_steer_rate cannot follow a Dubins or Reeds-Shepp path's steps and the car drifts off
+    (about 0.12 m, into a wall here for Dubins), while it follows a CC path's ramps (issue 36)."""
+    bang_bang, cc = steering, "cc-" + steering
     worst = {}
-    for steering in ("dubins", "cc-dubins"):
+    for steering in (bang_bang, cc):
         r = _cli(_plain(tmp_path), "--laps", 1, "--controller", "pd", "--seed", 0,
                  "--fixed-latency", 20, "--steering", steering, "--json")
         assert r.returncode == 0, r.stderr
         s = json.loads(r.stdout)
         assert s["parameters"]["steering"] == steering
         worst[steering] = s["cross_track_error_m"]["max"], s["collisions"], s["reached_goal"]
-    assert worst["cc-dubins"][0] < 0.5 * worst["dubins"][0]
-    assert worst["cc-dubins"][1:] == (0, True)
+    assert worst[cc][0] < 0.5 * worst[bang_bang][0]
+    assert worst[cc][1:] == (0, True)

@@ -50,8 +50,8 @@ def simulate(
     reverse: Annotated[bool, typer.Option(
         help="The car may back up to evade a mover.")] = True,
     steering: Annotated[str, typer.Option(
-        help="The replanner's steering: dubins, reeds-shepp or cc-dubins (continuous "
-             "curvature, which a steering servo can follow).")] = "dubins",
+        help="The replanner's steering: dubins, reeds-shepp, cc-dubins or cc-reeds-shepp "
+             "(cc: continuous curvature, which a steering servo can follow).")] = "dubins",
     realtime: Annotated[bool, typer.Option(help="Pace the run to the wall clock.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     log: Annotated[Path | None, typer.Option(help="Write the per-tick log (CSV).")] = None,
