@@ -2,9 +2,10 @@
 
     python benchmarks/bench_planner.py        # 5 static scenarios, budgets 0.1 s and 1 s, seeds 0-4
 
-Ours also runs with continuous-curvature steering (--steerings, default dubins and cc-dubins):
-OMPL has no CC space, so CC-Dubins is measured against our Dubins rate and OMPL RRT*'s Dubins
-rate (the CC path is the harder problem, so that ratio is conservative).
+Ours also runs with continuous-curvature steering (--steerings, default dubins, cc-dubins,
+reeds-shepp and cc-reeds-shepp): OMPL has no CC space, so a CC steering is measured against our
+rate with its bang-bang kin (Dubins, Reeds-Shepp) and OMPL RRT*'s Dubins rate (the CC path is the
+harder problem, so that ratio is conservative).
 
 "Best known" costs come from benchmarks/results/best_known.json; a scenario missing there is first
 run for --long-s seconds (default 20) with seeds 0-2 by ours and, with OMPL, by BIT*, and the
@@ -50,7 +51,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--seeds", nargs="+", type=int, default=list(range(5)))
     parser.add_argument("--budgets", nargs="+", type=float, default=[0.1, 1.0], metavar="SECONDS")
     parser.add_argument("--only", choices=[OURS, "ompl"], help="run only our planner or only OMPL")
-    parser.add_argument("--steerings", nargs="+", default=["dubins", "cc-dubins"],
+    parser.add_argument("--steerings", nargs="+",
+                        default=["dubins", "cc-dubins", "reeds-shepp", "cc-reeds-shepp"],
                         metavar="NAME", help="our steerings to run (OMPL's is Dubins)")
     parser.add_argument("--json", type=Path, metavar="OUT", help="also write every run's record")
     parser.add_argument("--ompl-from", type=Path, metavar="RECORDS",
@@ -279,18 +281,20 @@ def ratios_table(summary: dict, scenarios: list[str], budgets: list[float]) -> s
 
 
 def steering_table(summary: dict, scenarios: list[str], steering: str) -> str:
-    """Markdown table of our rate with ``steering`` against ours with Dubins and OMPL RRT*'s."""
+    """Markdown table of our rate with ``steering`` against ours with its bang-bang kin (a
+    CC steering's; Dubins else) and OMPL RRT*'s with Dubins."""
     label = our_label(steering)
-    lines = [f"| scenario | it/s {steering} | / ours Dubins | / OMPL RRT* Dubins |",
+    kin = "reeds-shepp" if steering == "cc-reeds-shepp" else "dubins"
+    lines = [f"| scenario | it/s {steering} | / ours {kin} | / OMPL RRT* Dubins |",
              "|---|---:|---:|---:|"]
     for scenario in scenarios:
         row = summary.get((scenario, label))
         if row is None:
             continue
-        dubins, rrtstar = summary.get((scenario, OURS)), summary.get((scenario, "RRTstar"))
+        ours, rrtstar = summary.get((scenario, our_label(kin))), summary.get((scenario, "RRTstar"))
         rate = row["iterations_per_s"]
         lines.append(f"| {scenario} | {_fmt(rate, '.0f')} | "
-                     f"{_ratio(rate, dubins and dubins['iterations_per_s'])} | "
+                     f"{_ratio(rate, ours and ours['iterations_per_s'])} | "
                      f"{_ratio(rate, rrtstar and rrtstar['iterations_per_s'])} |")
     return "\n".join(lines)
 

@@ -113,9 +113,12 @@ def test_the_profiles_shade_the_reverse_stretches_and_mark_the_cusps(parked, ser
     kmax = math.tan(math.radians(vehicle.max_steer_deg)) / vehicle.wheelbase
     assert f"σmax = 7 1/m²: from straight to full lock takes {kmax / 7:.2g} m" \
         in profiles.caption.content
-    profiles.set_steering("reeds-shepp")
+    profiles.set_steering("reeds-shepp", sigma=7.0)
     assert "reverse" in profiles.caption.content and "cusp" in profiles.caption.content
     profiles.show_path(path)
+    slope = [np.array(v, dtype=float) for v in profiles.slope.data]
+    assert np.all(slope[2] == 7.0) and np.all(slope[3] == -7.0)  # ±σmax
+    assert np.nanmax(np.abs(slope[1])) > 3 * 7.0  # a bang-bang step: κmax within one row
     s = arc_length(path)
     cusp_s = s[_cusps(path)]
     for chart in (profiles.curvature, profiles.steering):

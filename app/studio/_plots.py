@@ -1,7 +1,8 @@
 """Profile plots (uPlot through viser): curvature and steering along the best path beside the
 track centreline, the ±δmax band shaded; the steering rate dδ/dt the path asks of the servo as
 it is driven (its t column) against ±max_steer_rate — Dubins' steps are spikes off the chart,
-continuous-curvature ramps stay inside; the fastest speed the car may drive the path at under
+continuous-curvature ramps stay inside; the same for the curvature's slope dκ/ds against ±σmax,
+the sharpness a continuous-curvature steering plans with; the fastest speed the car may drive the path at under
 its speed limit and lateral and longitudinal accelerations (`tracks.path_rows`, the raceline's
 profile), under the shaded envelope min(v_max, √(a_lat/|κ|)); and the best cost over planning
 time.
@@ -77,6 +78,17 @@ def _rate(s_grid: np.ndarray, path: np.ndarray, wheelbase: float) -> np.ndarray:
     dt = np.diff(path[:, 5])
     rate = np.diff(_steer_deg(path[:, 3], wheelbase)) / np.where(dt > 0, dt, math.nan)
     return _along(s_grid, arc_length(path)[1:], rate)
+
+
+def _slope(s_grid: np.ndarray, path: np.ndarray) -> np.ndarray:
+    """dκ/ds (1/m²) along a path (columns x, y, θ, κ, …) at the grid points: the change of κ
+    between rows over the distance between them, the rate a continuous-curvature steering
+    keeps within σmax; none where no distance passes (a turn on the spot)."""
+    if len(path) < 2:
+        return np.full(len(s_grid), math.nan)
+    ds = np.diff(arc_length(path))
+    slope = np.diff(path[:, 3]) / np.where(ds > 0, ds, math.nan)
+    return _along(s_grid, arc_length(path)[1:], slope)
 
 
 def _held(grid: np.ndarray, t: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -157,7 +169,8 @@ class Profiles:
         self._limits = limits
         band = ({"series": (3, 4), "fill": "rgba(80,200,120,0.12)"},)
         self._cusps: tuple = ()  # the grid indices of the current path's cusps
-        kappa, steer, rate, speed = map(_for_uplot, self._profiles(np.zeros((0, 6))))
+        self._sigma = math.nan  # σmax at the planned speed (`set_steering`)
+        kappa, steer, rate, slope, speed = map(_for_uplot, self._profiles(np.zeros((0, 6))))
         common = {"aspect": 1.6, "bands": band, "legend": {"show": True}, "scales": NUMERIC_X}
         self.caption = gui.add_markdown(STEERINGS[DEFAULT_STEERING].curvature)
         self.curvature = gui.add_uplot(
@@ -177,6 +190,12 @@ class Profiles:
             title="Steering rate dδ/dt (deg/s) vs s (m), as driven",
             **common | {"bands": ({"series": (2, 3), "fill": "rgba(80,200,120,0.12)"},),
                         "scales": NUMERIC_X | {"y": {"range": [-2 * self._rmax, 2 * self._rmax]}}})
+        self.slope = gui.add_uplot(
+            slope, (_series("s (m)"), _series("path dκ/ds", CURRENT, 2.0),
+                    _series("+σmax", "#2e9e5b", 1, [4, 4]),
+                    _series("−σmax", "#2e9e5b", 1, [4, 4])),
+            title="Curvature slope dκ/ds (1/m²) vs s (m), against the servo's σmax",
+            **common | {"bands": ({"series": (2, 3), "fill": "rgba(80,200,120,0.12)"},)})
         self.speed = gui.add_uplot(
             speed, (_series("s (m)"), _series("path v", CURRENT, 2.0),
                     _series(f"limit (v ≤ {limits.v_max:g}, a_lat ≤ {limits.a_lat:g}, "
@@ -189,16 +208,19 @@ class Profiles:
             (_series("planning time (s)"), _series("best cost (m)", CURRENT, 2.0)),
             title="Best cost over time", aspect=2.2, scales=NUMERIC_X)
         self._series = [h.series for h in (self.curvature, self.steering, self.cost)]  # no pins
-        self._rate_series = self.rate.series
+        self._rate_series, self._slope_series = self.rate.series, self.slope.series
 
     @property
     def handles(self) -> tuple:
-        return self.caption, self.curvature, self.steering, self.rate, self.speed, self.cost
+        return (self.caption, self.curvature, self.steering, self.rate, self.slope, self.speed,
+                self.cost)
 
     def set_steering(self, name: str, b: str | None = None, sigma: float = math.inf) -> None:
         """The caption for paths of this steering (`planner.STEERINGS`' names) and, in the
         split, for run B's where it is another; a continuous-curvature one's says what its
-        sharpness ``sigma`` (σmax, 1/m²) makes of a turn."""
+        sharpness ``sigma`` (σmax, 1/m²) makes of a turn. ``sigma`` is also the slope chart's
+        limit, for every steering: a bang-bang path's steps cross it."""
+        self._sigma = sigma
 
         def said(steering) -> str:
             if not steering.continuous or not math.isfinite(sigma):
@@ -218,11 +240,12 @@ class Profiles:
         """The compared runs besides the current one: the pins, then run B."""
         return [*self._pins, *([self._split] if self._split is not None else [])]
 
-    def _profiles(self, path: np.ndarray) -> tuple[tuple, tuple, tuple, tuple]:
+    def _profiles(self, path: np.ndarray) -> tuple[tuple, tuple, tuple, tuple, tuple]:
         """(curvature, steering data): x, centreline, path, +max, −max, the path's reverse
         shading and cusps, each other run's reverse shading, each other run (`_others`), on
         one s grid as long as the longest path (with the cusps' s in it); (rate data): x, the
-        path's dδ/dt, ±the servo's limit; (speed data): x, the path's speed, its envelope, 0."""
+        path's dδ/dt, ±the servo's limit, each other run's; (slope data): the same for dκ/ds
+        and ±σmax; (speed data): x, the path's speed, its envelope, 0."""
         others = self._others
         paths = [path, *(r.path for r in others)]
         end = max((arc_length(p)[-1] for p in paths if len(p) >= 2), default=self._goal_s)
@@ -243,7 +266,10 @@ class Profiles:
                  *(_steer_deg(k, r.vehicle.wheelbase) for k, r in zip(pins, others)))
         rate = (grid, _rate(grid, path, self._wb), self._rmax * one, -self._rmax * one,
                 *(_rate(grid, r.path, r.vehicle.wheelbase) for r in others))
-        return kappa, steer, rate, self._speed(grid, path)
+        sigma = self._sigma if math.isfinite(self._sigma) else math.nan
+        slope = (grid, _slope(grid, path), sigma * one, -sigma * one,
+                 *(_slope(grid, r.path) for r in others))
+        return kappa, steer, rate, slope, self._speed(grid, path)
 
     def _speed(self, grid: np.ndarray, path: np.ndarray) -> tuple:
         """The path's fastest speed profile and its envelope on the grid (NaN without one)."""
@@ -259,7 +285,7 @@ class Profiles:
     def show_path(self, path: np.ndarray, split=None) -> None:
         """The current run's best path and, in the split, run B (a `_compare.Run`)."""
         self._path, self._split = path, split
-        kappa, steer, rate, speed = self._profiles(path)
+        kappa, steer, rate, slope, speed = self._profiles(path)
         # viser's client rebuilds a chart whose series change and keeps its x zoom relative
         # to the data: a rebuild with a new x range keeps a stale one. While the series are
         # as many, the data goes first, so that a rebuild finds its x range in place.
@@ -269,6 +295,7 @@ class Profiles:
         self.curvature.data = _for_uplot(kappa)
         self.steering.data = _for_uplot(steer)
         self.rate.data = _for_uplot(rate)
+        self.slope.data = _for_uplot(slope)
         self.speed.data = _for_uplot(speed)
         if first:
             self._sync_series()
@@ -299,11 +326,11 @@ class Profiles:
                 shades = tuple(_other_shade(r, limit) for r in others)
             h.series = base + shades + tuple(_series(r.name + symbol, r.colour, 1.5)
                                              for r in others)
-        base = self._rate_series
-        if self._split is not None:
-            base = (base[0], base[1] | {"label": "A dδ/dt"}, *base[2:])
-        self.rate.series = base + tuple(_series(r.name + " dδ/dt", r.colour, 1.5)
-                                        for r in others)
+        for h, base, symbol in ((self.rate, self._rate_series, " dδ/dt"),
+                                (self.slope, self._slope_series, " dκ/ds")):
+            if self._split is not None:
+                base = (base[0], base[1] | {"label": "A" + symbol}, *base[2:])
+            h.series = base + tuple(_series(r.name + symbol, r.colour, 1.5) for r in others)
 
     def show_cost(self, current, split=None) -> None:
         """The current run's (a `_compare.Run`) best cost against planning time and the other
