@@ -39,30 +39,37 @@ _MAX_ELEMENTS = 5  # TcTSTcT: four turns and a straight
 
 
 @njit(cache=True, inline="always")
-def _centre(g, x, y, th, gear, d):
-    """Centre of the circle a turn of ``gear`` and direction ``d`` leaves pose (x, y, th) on
-    (with −gear: the circle such a turn arrives at it on)."""
-    r, smu, cmu = g[3], g[4], g[5]
-    ox, oy = gear * r * smu, d * r * cmu
-    c, s = math.cos(th), math.sin(th)
-    return x + c * ox - s * oy, y + s * ox + c * oy
+def _offset(cx, cy, c, s, u, v):
+    """(cx, cy) + R·(u, v), R the rotation by the angle of cosine c and sine s."""
+    return cx + c * u - s * v, cy + s * u + c * v
 
 
 @njit(cache=True, inline="always")
-def _arrival(g, cx, cy, th, gear, d):
-    """The pose of heading ``th`` where a turn of ``gear`` and direction ``d`` on the circle
-    centred (cx, cy) ends."""
-    x, y = _centre(g, 0.0, 0.0, th, -gear, d)
-    return cx - x, cy - y, th
+def _centre(g, x, y, c, s, gear, d):
+    """Centre of the circle a turn of ``gear`` and direction ``d`` leaves the pose at (x, y),
+    heading (c, s) = (cos θ, sin θ), on (with −gear: the circle such a turn arrives on)."""
+    return _offset(x, y, c, s, gear * g[3] * g[4], d * g[3] * g[5])
+
+
+@njit(cache=True, inline="always")
+def _arrival(g, cx, cy, c, s, gear, d):
+    """Where a turn of ``gear`` and direction ``d`` on the circle centred (cx, cy) ends
+    heading (c, s)."""
+    return _offset(cx, cy, c, s, gear * g[3] * g[4], -d * g[3] * g[5])
 
 
 @njit(cache=True, inline="always")
 def _joint(g, ax, ay, ga, da, bx, by, gb):
     """The pose where a turn (ga, da) on circle a hands over to a turn of gear gb and the
-    opposite direction on circle b, 2r (gb = ga) or 2r·cos μ (a cusp) away."""
-    r, smu, cmu = g[3], g[4], g[5]
-    th = math.atan2(by - ay, bx - ax) - math.atan2(-2.0 * da * r * cmu, (ga + gb) * r * smu)
-    return _arrival(g, ax, ay, th, ga, da)
+    opposite direction on circle b, 2r (gb = ga) or 2r·cos μ (a cusp) away: its heading is
+    the direction from a to b turned by da·(π/2 − μ·(ga + gb)/2), rotated here without trig."""
+    ex, ey = bx - ax, by - ay
+    big_d = math.hypot(ex, ey)
+    cb = 0.5 * (ga + gb) * g[4]  # cos and sin of the turn
+    sb = da * (g[5] if ga == gb else 1.0)
+    c, s = (ex * cb - ey * sb) / big_d, (ey * cb + ex * sb) / big_d
+    x, y = _arrival(g, ax, ay, c, s, ga, da)
+    return x, y, math.atan2(s, c)
 
 
 @njit(cache=True, inline="always")
@@ -80,24 +87,20 @@ def _tangent(g, ax, ay, ga, da, gs, bx, by, gb, db, root):
     r, smu, cmu = g[3], g[4], g[5]
     ex, ey = bx - ax, by - ay
     side = (db - da) * r * cmu
-    dd = ex * ex + ey * ey - side * side
-    if dd < 0.0:
+    ee = ex * ex + ey * ey
+    dd = ee - side * side
+    if dd < 0.0 or ee == 0.0:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     along = root * math.sqrt(dd)
     length = gs * (along - (ga + gb) * r * smu)
     if length < -_TINY * r:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     length = max(length, 0.0)
-    th = math.atan2(ey, ex) - math.atan2(side, along)
-    qx, qy, _ = _arrival(g, ax, ay, th, ga, da)
-    return (True, qx, qy, th, qx + gs * length * math.cos(th), qy + gs * length * math.sin(th),
-            th, length)
-
-
-@njit(cache=True, inline="always")
-def _offset(cx, cy, c, s, u, v):
-    """(cx, cy) + R·(u, v), R the rotation by the angle of cosine c and sine s."""
-    return cx + c * u - s * v, cy + s * u + c * v
+    # the straight's heading: the direction a → b turned back by atan2(side, along)
+    c, s = (ex * along + ey * side) / ee, (ey * along - ex * side) / ee
+    th = math.atan2(s, c)
+    qx, qy = _arrival(g, ax, ay, c, s, ga, da)
+    return True, qx, qy, th, qx + gs * length * c, qy + gs * length * s, th, length
 
 
 @njit(cache=True)
@@ -153,6 +156,7 @@ def _search(g, x0, y0, th0, x1, y1, th1, bound, best_poses, best_elems):
     dx, dy = x1 - x0, y1 - y0
     dist = math.hypot(dx, dy)
     c0, s0 = math.cos(th0), math.sin(th0)
+    c1, s1 = math.cos(th1), math.sin(th1)
     _set(poses, 0, x0, y0, th0)
     # Aligned: one straight, ahead or behind
     if abs(wrap_angle(th1 - th0)) < _TINY \
@@ -162,10 +166,10 @@ def _search(g, x0, y0, th0, x1, y1, th1, bound, best_poses, best_elems):
         best, best_n = _keep(g, poses, elems, 1, best, best_n, best_poses, best_elems)
     for g1 in (1.0, -1.0):
         for d1 in (1.0, -1.0):
-            ax, ay = _centre(g, x0, y0, th0, g1, d1)
+            ax, ay = _centre(g, x0, y0, c0, s0, g1, d1)
             for gn in (1.0, -1.0):
                 for dn in (1.0, -1.0):
-                    bx, by = _centre(g, x1, y1, th1, -gn, dn)
+                    bx, by = _centre(g, x1, y1, c1, s1, -gn, dn)
                     ex, ey = bx - ax, by - ay
                     big_d = math.hypot(ex, ey)
                     cp, sp = (ex / big_d, ey / big_d) if big_d > 0.0 else (1.0, 0.0)
@@ -189,31 +193,41 @@ def _search(g, x0, y0, th0, x1, y1, th1, bound, best_poses, best_elems):
                                 _elem(elems, 2, _TURN, gn, dn)
                                 best, best_n = _keep(g, poses, elems, 3, best, best_n,
                                                      best_poses, best_elems)
-                    if dn == d1:
-                        # TTT: a middle circle of direction −d1 tangent to both
-                        for g2 in (1.0, -1.0):
-                            l1, l2 = _link(g, g1, g2), _link(g, g2, gn)
-                            if big_d > l1 + l2 or big_d < abs(l1 - l2) or big_d == 0.0:
-                                continue
-                            u = (big_d * big_d + l1 * l1 - l2 * l2) / (2.0 * big_d)
-                            v = math.sqrt(max(l1 * l1 - u * u, 0.0))
-                            for side in (1.0, -1.0):
-                                mx, my = _offset(ax, ay, cp, sp, u, side * v)
-                                _set_joint(g, poses, 1, ax, ay, g1, d1, mx, my, g2)
-                                _set_joint(g, poses, 2, mx, my, g2, -d1, bx, by, gn)
-                                _set(poses, 3, x1, y1, th1)
-                                _elem(elems, 0, _TURN, g1, d1)
-                                _elem(elems, 1, _TURN, g2, -d1)
-                                _elem(elems, 2, _TURN, gn, dn)
-                                best, best_n = _keep(g, poses, elems, 3, best, best_n,
-                                                     best_poses, best_elems)
-                    else:
-                        best, best_n = _four_turns(g, ax, ay, g1, d1, bx, by, gn, big_d, cp,
-                                                   sp, x1, y1, th1, poses, elems, best, best_n,
-                                                   best_poses, best_elems)
-                    best, best_n = _with_cusped_turns(g, ax, ay, g1, d1, bx, by, gn, dn, big_d,
-                                                      cp, sp, x1, y1, th1, poses, elems, best,
-                                                      best_n, best_poses, best_elems)
+                    best, best_n = _three_or_more(g, ax, ay, g1, d1, bx, by, gn, dn, big_d, cp,
+                                                  sp, x1, y1, th1, poses, elems, best, best_n,
+                                                  best_poses, best_elems)
+    return best, best_n
+
+
+@njit(cache=True)
+def _three_or_more(g, ax, ay, g1, d1, bx, by, gn, dn, big_d, cp, sp, x1, y1, th1, poses, elems,
+                   best, best_n, best_poses, best_elems):
+    """The chains of three turns or more from circle a (g1, d1) to circle b (gn, dn)."""
+    if dn == d1:
+        # TTT: a middle circle of direction −d1 tangent to both
+        for g2 in (1.0, -1.0):
+            l1, l2 = _link(g, g1, g2), _link(g, g2, gn)
+            if big_d > l1 + l2 or big_d < abs(l1 - l2) or big_d == 0.0:
+                continue
+            u = (big_d * big_d + l1 * l1 - l2 * l2) / (2.0 * big_d)
+            v = math.sqrt(max(l1 * l1 - u * u, 0.0))
+            for side in (1.0, -1.0):
+                mx, my = _offset(ax, ay, cp, sp, u, side * v)
+                _set_joint(g, poses, 1, ax, ay, g1, d1, mx, my, g2)
+                _set_joint(g, poses, 2, mx, my, g2, -d1, bx, by, gn)
+                _set(poses, 3, x1, y1, th1)
+                _elem(elems, 0, _TURN, g1, d1)
+                _elem(elems, 1, _TURN, g2, -d1)
+                _elem(elems, 2, _TURN, gn, dn)
+                best, best_n = _keep(g, poses, elems, 3, best, best_n,
+                                     best_poses, best_elems)
+    else:
+        best, best_n = _four_turns(g, ax, ay, g1, d1, bx, by, gn, big_d, cp,
+                                   sp, x1, y1, th1, poses, elems, best, best_n,
+                                   best_poses, best_elems)
+    best, best_n = _with_cusped_turns(g, ax, ay, g1, d1, bx, by, gn, dn, big_d,
+                                      cp, sp, x1, y1, th1, poses, elems, best,
+                                      best_n, best_poses, best_elems)
     return best, best_n
 
 
