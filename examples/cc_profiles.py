@@ -1,9 +1,11 @@
-"""The same route planned with Dubins and with CC-Dubins steering, and what a servo must do.
+"""The same route planned with a bang-bang and with a continuous-curvature steering, and what a
+servo must do.
 
     python examples/cc_profiles.py thesis_half_lap docs/img/cc_dubins_profiles.png
+    python examples/cc_profiles.py parking docs/img/cc_reeds_shepp_profiles.png reeds-shepp
 
 Plans the scenario (a bundled name or a scenario file) with RRT* for 3000 iterations, seed 0,
-once per steering, and plots the paths, their curvature κ(s), steering angle δ(s) = atan(Lκ)
+with the steering named third (default dubins) and its CC kin (cc-dubins), and plots the paths, their curvature κ(s), steering angle δ(s) = atan(Lκ)
 against ±δmax and the steering rate dδ/dt at the planned speed against the servo's
 ±max_steer_rate. Dubins' steps show as spikes of dδ/dt (a jump over one 5 cm row); CC-Dubins
 ramps stay within the limit. Needs matplotlib.
@@ -23,10 +25,10 @@ import matplotlib.pyplot as plt
 
 import planner
 
-STEERINGS = {"dubins": "#d6336c", "cc-dubins": "#1c7ed6"}
+COLOURS = ("#d6336c", "#1c7ed6")  # the bang-bang steering, its CC kin
 
 
-def main(scenario: str, out: str) -> None:
+def main(scenario: str, out: str, kin: str = "dubins") -> None:
     path = Path(scenario) if Path(scenario).is_file() else planner.bundled_scenario_path(scenario)
     scn = planner.parse_scenario(json.loads(path.read_text()))
     vehicle = scn.vehicle
@@ -34,7 +36,7 @@ def main(scenario: str, out: str) -> None:
     grid = fig.add_gridspec(3, 2, width_ratios=(1, 1.3))
     plane = fig.add_subplot(grid[:, 0])
     kappa, delta, rate = (fig.add_subplot(grid[i, 1]) for i in range(3))
-    for steering, colour in STEERINGS.items():
+    for steering, colour in zip((kin, "cc-" + kin), COLOURS):
         result = planner.solve(scn, steering=steering, time_limit=None, iterations=3000, seed=0)
         rows = result.path
         s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(rows[:, :2], axis=0).T))])
@@ -57,11 +59,11 @@ def main(scenario: str, out: str) -> None:
     rate.set_ylim(-3 * vehicle.max_steer_rate_deg_s, 3 * vehicle.max_steer_rate_deg_s)
     rate.set_xlabel("arc length s (m)")
     rate.set_title(f"at the planned speed; dashed: the servo's ±{vehicle.max_steer_rate_deg_s:g}°/s"
-                   f" (Dubins' jumps run off the chart)", fontsize=8)
+                   f" ({planner.STEERINGS[kin].label}'s jumps run off the chart)", fontsize=8)
     kappa.set_title(f"dashed: ±κmax = 1/ρ, ρ = {vehicle.turning_radius:.3f} m", fontsize=8)
     fig.savefig(out, dpi=110)
     print(f"wrote {out}")
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:3])
+    main(*sys.argv[1:4])
