@@ -196,7 +196,7 @@ def test_scene_renders_a_library_track_and_run_grows_the_tree(browser, ui_url):
     box = plots.first.bounding_box()
     assert box and box["width"] > 100 and box["height"] > 50
     assert page.locator(".u-title", has_text="Fastest speed v (m/s) vs s").count() == 1
-    speed = page.locator(".uplot").nth(3)
+    speed = page.locator(".uplot", has_text="Fastest speed v (m/s) vs s")
     speed.scroll_into_view_if_needed()
     speed.locator(".u-over").hover(force=True)  # the cursor fills the legend's values
     legends = " ".join(page.locator(".u-legend").all_inner_texts())

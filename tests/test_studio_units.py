@@ -593,10 +593,10 @@ def test_pinned_runs_keep_their_colours_and_the_comparison_has_a_row_and_curves_
     profiles.show_path(star.path)
     profiles.show_cost(star)
     profiles.set_pins(pins.runs)
-    curvature, steering, rate, _, cost = charts
-    for chart in (curvature, steering, rate, cost):
+    curvature, steering, rate, slope, _, cost = charts
+    for chart in (curvature, steering, rate, slope, cost):
         assert [s["label"] for s in chart.series[-2:]] in (
-            [f"pin 1{x}", f"pin 2{x}"] for x in (" κ", " δ", " dδ/dt", ""))
+            [f"pin 1{x}", f"pin 2{x}"] for x in (" κ", " δ", " dδ/dt", " dκ/ds", ""))
         assert len(chart.series) == len(chart.data)
         assert len({len(d) for d in chart.data}) == 1
         assert not any(np.isnan(d[0]) for d in chart.data[1:])
