@@ -149,7 +149,7 @@ def _keep(g, poses, elems, n, best, best_n, best_poses, best_elems):
 def _search(g, x0, y0, th0, x1, y1, th1, bound, best_poses, best_elems):
     """The shortest chain from pose 0 to pose 1 shorter than ``bound``: (length, elements);
     written into best_poses/best_elems. (math.inf, 0) if none is."""
-    r, cmu = g[3], g[5]
+    r = g[3]
     poses = np.empty((_MAX_ELEMENTS + 1, 3))
     elems = np.zeros((_MAX_ELEMENTS, 3))
     best, best_n = bound, 0

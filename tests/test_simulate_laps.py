@@ -180,12 +180,12 @@ def test_the_first_plan_is_not_a_replan():
     assert s["cycles"] >= 1 and s["replans"] == 0
 
 
-@pytest.mark.parametrize("steering", ["dubins", "reeds-shepp"])
-def test_a_continuous_curvature_lap_is_tracked_closer_than_a_bang_bang_one(tmp_path, steering):
+@pytest.mark.parametrize("bang_bang", ["dubins", "reeds-shepp"])
+def test_a_continuous_curvature_lap_is_tracked_closer_than_a_bang_bang_one(tmp_path, bang_bang):
     """The thesis's PD feeds the plan's curvature forward as δ = atan(Lκ): a servo at
     max_steer_rate cannot follow a Dubins or Reeds-Shepp path's steps and the car drifts off
     (about 0.12 m, into a wall here for Dubins), while it follows a CC path's ramps (issue 36)."""
-    bang_bang, cc = steering, "cc-" + steering
+    cc = "cc-" + bang_bang
     worst = {}
     for steering in (bang_bang, cc):
         r = _cli(_plain(tmp_path), "--laps", 1, "--controller", "pd", "--seed", 0,
