@@ -497,13 +497,18 @@ def warm_up() -> None:
     from planner._world import build_world
 
     # A metre square: its distance grid has the fewest cells (a tenth of a bundled scene's).
-    world = build_world((0, 0, 1, 1), 0.01, [(0.5, 0.5, 0.1, -1)],
-                        [([(0.1, 0.1), (0.2, 0.1), (0.2, 0.2)], 0)], [("velocity", (0.01, 0))])
-    problem = Problem(None, world, (0.05, 0.05, 0.0), (0.9, 0.9, 0.0), 0.05, 0.5, 0.1, 0.1, True)
-    # One kernel serves every planner and steering (they are parameters, not types). Unsolved
-    # after 40 iterations: the path kernels load with a plan's first result, not with every
-    # process (a plan of one iteration, a worker's first job).
-    p = Planner(problem, PlanOptions(planner="rrtstar", steering=DEFAULT_STEERING))
-    p.step(40)
-    p.result()
+    # One kernel serves every planner and steering (they are parameters, not types); a world
+    # in space-time and a static one, solved (after 60 iterations) and their results taken, so
+    # that the kernels of rows, re-rooting and polishing (static plans only) compile here as
+    # well: after an install, not inside the first plan's time budget, which they took 20 s
+    # of. Loading them from numba's cache costs a process 0.02 s.
+    triangle = [(0.1, 0.1), (0.2, 0.1), (0.2, 0.2)]
+    for movers in ([("velocity", (0.01, 0))], []):
+        world = build_world((0, 0, 1, 1), 0.01, [(0.5, 0.5, 0.1, -1)],
+                            [(triangle, 0 if movers else -1)], movers)
+        problem = Problem(None, world, (0.05, 0.05, 0.0), (0.9, 0.9, 0.0), 0.05, 0.5, 0.1, 0.1,
+                          bool(movers))
+        p = Planner(problem, PlanOptions(planner="rrtstar", steering=DEFAULT_STEERING))
+        p.step(200)
+        p.result()
     _warm = True
