@@ -19,7 +19,7 @@ from pydantic import ConfigDict, Field
 
 from app.planning import TrackSource, track_loader
 from planner.options import TIMINGS, Seed
-from planner.steering import DEFAULT_STEERING, STEERINGS
+from planner.steering import CAR_STEERINGS, DEFAULT_STEERING, STEERINGS
 from planner.validation import KnownKeys
 
 __all__ = ["MAX_DURATION_S", "SimOptions", "SimulationStopped", "read_progress",
@@ -33,8 +33,7 @@ MAX_LATENCY_MS = 60_000.0  # a fixed cycle time of a minute
 MAX_PREDICT_ACCEL, MAX_PREDICT_SPEED, MAX_PREDICT_HORIZON_S = 100.0, 100.0, 60.0
 
 Rate = Annotated[float, Field(ge=MIN_RATE_HZ, le=MAX_RATE_HZ, allow_inf_nan=False)]
-# A car's steerings: the simulated car cannot turn on the spot.
-CarSteering = Literal[tuple(name for name, s in STEERINGS.items() if not s.heading_free)]
+CarSteering = Literal[CAR_STEERINGS]
 PROGRESS_EVERY_S = 0.25  # wall time between progress writes
 
 
@@ -77,7 +76,7 @@ class SimOptions(KnownKeys):
     reverse: bool = Field(True, description="the car may back up to evade a mover")
     steering: CarSteering = Field(
         DEFAULT_STEERING, description="the replanner's steering: " + "; ".join(
-            f"{s.name} {s.summary}" for s in STEERINGS.values() if not s.heading_free))
+            f"{name} {STEERINGS[name].summary}" for name in CAR_STEERINGS))
 
     def settings(self, **local):
         """The `planner.sim.SimSettings` of these options and of ``local`` ones (the command

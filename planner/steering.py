@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-__all__ = ["DEFAULT_STEERING", "STEERINGS", "Steering", "SteeringName"]
+__all__ = ["CAR_STEERINGS", "DEFAULT_STEERING", "STEERINGS", "Steering", "SteeringName"]
 
 # the kernel's codes (`_steer.py` dispatches on them)
 DUBINS, REEDS_SHEPP, STRAIGHT, CC_DUBINS, CC_REEDS_SHEPP = range(5)
@@ -83,3 +83,5 @@ STEERINGS = {s.name: s for s in (
 DEFAULT_STEERING = next(iter(STEERINGS))
 
 SteeringName = Literal[tuple(STEERINGS)]  # the names, for pydantic and typer
+# The steerings a car can drive (the simulated car cannot turn on the spot).
+CAR_STEERINGS = tuple(name for name, s in STEERINGS.items() if not s.heading_free)

@@ -12,7 +12,7 @@ import typer
 from app.cli._errors import user_errors
 from app.cli._plan import ScenarioArg
 from app.kernels import warm_kernels
-from planner.steering import STEERINGS
+from planner.steering import CAR_STEERINGS
 
 
 def simulate(
@@ -51,8 +51,7 @@ def simulate(
     reverse: Annotated[bool, typer.Option(
         help="The car may back up to evade a mover.")] = True,
     steering: Annotated[str, typer.Option(
-        help="The replanner's steering: " + ", ".join(
-            name for name, s in STEERINGS.items() if not s.heading_free)
+        help="The replanner's steering: " + ", ".join(CAR_STEERINGS)
              + " (cc: continuous curvature, which a steering servo can follow).")] = "dubins",
     realtime: Annotated[bool, typer.Option(help="Pace the run to the wall clock.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,

@@ -40,7 +40,7 @@ from planner.sim.replan import Replanner
 from planner.sim.replan import warm_up as warm_up_replanning
 from planner.sim.sensing import Sensing, known_motions, mover_index, sense, true_offsets
 from planner.sim.vehicle import Limits, arc_step, limit_commands
-from planner.steering import DEFAULT_STEERING, STEERINGS
+from planner.steering import CAR_STEERINGS, DEFAULT_STEERING
 from planner.timing import warm_up as warm_up_timing
 from planner.tree import TreeSnapshot
 
@@ -92,10 +92,9 @@ class SimSettings:
                                  f"got {v}")
         if self.timing not in TIMINGS:
             raise ValueError(f"--timing must be one of {', '.join(TIMINGS)}, got {self.timing!r}")
-        car = [name for name, s in STEERINGS.items() if not s.heading_free]
-        if self.steering not in car:
-            raise ValueError(f"--steering must be one of {', '.join(car)} (the simulated car "
-                             f"cannot turn on the spot), got {self.steering!r}")
+        if self.steering not in CAR_STEERINGS:
+            raise ValueError(f"--steering must be one of {', '.join(CAR_STEERINGS)} (the "
+                             f"simulated car cannot turn on the spot), got {self.steering!r}")
         if self.controller not in CONTROLLERS:
             raise ValueError(f"unknown controller '{self.controller}' "
                              f"(use one of {', '.join(CONTROLLERS)})")
