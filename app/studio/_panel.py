@@ -149,8 +149,9 @@ def build_panel(gui) -> Panel:
             "max_steer_deg": gui.add_number("Max steering angle (deg)", 26.0, step=1.0),
             "max_steer_rate_deg_s": gui.add_number(
                 "Max steering rate (deg/s)", 180.0, step=10.0,
-                hint="How fast the steering servo turns: CC-Dubins ramps its curvature so that "
-                     "the planned speed never asks for more; Simulate's servo turns this fast"),
+                hint="How fast the steering servo turns: the CC steerings ramp their curvature "
+                     "so that the planned speed never asks for more; Simulate's servo turns "
+                     "this fast"),
             "footprint": gui.add_dropdown("Footprint", FOOTPRINTS, initial_value="disc"),
             "radius": gui.add_number("Disc radius (m)", 0.0, step=0.01,
                                      hint="0: the car is a point"),
