@@ -135,6 +135,62 @@ def test_controllers_follow_a_circle(name):
     assert errs[1000:].max() < 0.05, errs[1000:].max()
 
 
+@pytest.mark.parametrize("name", CONTROLLERS)
+def test_controllers_back_along_a_circle(name):
+    """Reversing round a 2 m circle (the steering left, so the car turns right) from 0.3 m
+    off it: each controller steers the mirror car, and the error settles as it does forward."""
+    radius, L, dt = 2.0, 0.44, 0.01
+    a = np.linspace(0, 4 * math.pi, 4000)
+    rows = np.column_stack([-radius * np.sin(a), radius * (1 - np.cos(a)), -a,
+                            np.full_like(a, 1 / radius), -np.ones_like(a)])
+    ref = Reference(rows)
+    assert ref.direction == -1.0 and len(ref.signs) == 1
+    lim = Limits(L, math.radians(30), math.radians(180), 1.0, 1.0)
+    x, y, th, v, s, e_old, errs = 0.0, -0.3, 0.0, 0.0, 0.0, math.nan, []
+    for _ in range(2000):
+        i, e = ref.project(x, y)
+        want = steer_command(name, ref, i, e, e_old, (x, y, th), v, L, dt, Tracking())
+        v, s = limit_commands(v, s, -1.0, want, lim, dt)
+        x, y, th = arc_step(x, y, th, v, s, L, dt)
+        e_old = e
+        errs.append(math.hypot(x, y - radius) - radius)
+    errs = np.abs(errs)
+    assert errs[:100].max() > 0.2  # it did start off the path
+    assert errs[1000:].max() < 0.05, errs[1000:].max()
+    assert ref.s[ref.cursor] > 9.0  # it went round, backwards
+
+
+def test_a_cusp_is_passed_at_rest_only():
+    """Forward 1 m, then back 1 m along a line: the projection keeps to the stretch the car is
+    on (the rows of both lie on top of each other) and goes on to the next only at rest."""
+    x = np.concatenate([np.linspace(0, 1, 21), np.linspace(1, 0, 21)[1:]])
+    dirs = np.concatenate([np.ones(21), -np.ones(20)])
+    ref = Reference(np.column_stack([x, np.zeros((len(x), 3)), dirs]))
+    assert ref.signs.tolist() == [1.0, -1.0] and ref.stretch_end == pytest.approx(1.0)
+    i, _ = ref.project(0.3, 0.0)
+    assert (i, ref.direction) == (6, 1.0)
+    ref.project(0.8, 0.0)
+    assert not ref.advance(0.0)  # standing 0.2 m before the cusp
+    ref.project(1.0, 0.0)
+    assert not ref.advance(0.2) and ref.direction == 1.0  # still rolling forward
+    assert ref.advance(0.0) and ref.direction == -1.0 and ref.stretch_end == pytest.approx(2.0)
+    i, _ = ref.project(0.7, 0.0)  # on the way back: the row of the second stretch
+    assert i == 26 and ref.s[i] == pytest.approx(1.3)
+    ref.project(0.0, 0.0)  # the end of the last stretch
+    assert not ref.advance(0.0) and ref.direction == -1.0
+
+
+def test_a_reversing_car_parks_backing_into_the_slot():
+    """Reeds-Shepp plans are driven as planned: forward and reverse stretches, at rest at each
+    cusp, tracked to a few centimetres, without a contact (recounted independently)."""
+    scn, run = _run("parking", duration=30.0, seed=0, steering="reeds-shepp")
+    s, v = run.summary, run.log[:, 4]
+    assert s["reached_goal"] and s["collisions"] == 0 and _independent_collisions(scn, run.log) == 0
+    assert (v < -0.5).sum() > 100 and (v > 0.5).sum() > 100  # it drove both ways
+    assert s["cross_track_error_m"]["max"] < 0.06
+    assert _replay_error(run.log, 0.44, 0.01) < 1e-8
+
+
 # -- whole runs ----------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def crossing_run():

@@ -16,34 +16,72 @@ import numpy as np
 __all__ = ["CONTROLLERS", "Reference", "Tracking", "steer_command"]
 
 CONTROLLERS = ("pure-pursuit", "stanley", "pd")
+CUSP_REACH = 0.1  # m before a cusp within which a car at rest counts as at it
 
 
 class Reference:
-    """A dense path (rows x, y, θ, κ, direction) with its arc length, and a projection cursor."""
+    """A dense path (rows x, y, θ, κ, direction) with its arc length, and a projection cursor.
+
+    A path that reverses (Reeds-Shepp) is driven stretch by stretch: the car stops at each
+    cusp (the row where the direction changes) and only then goes on along the next stretch.
+    The projection stays on the current stretch, since the rows on either side of a cusp lie
+    on top of each other; a row's direction is how the car arrives at it.
+    """
 
     def __init__(self, rows: np.ndarray) -> None:
         self.rows = np.asarray(rows, dtype=float)
         step = np.hypot(*np.diff(self.rows[:, :2], axis=0).T)
         self.s = np.concatenate([[0.0], np.cumsum(step)])
         self.cursor = 0
+        dirs = self.rows[:, 4] if self.rows.shape[1] > 4 else np.ones(len(self.rows))
+        cusps = np.flatnonzero(dirs[2:] != dirs[1:-1]) + 1  # row 0's arrival is not driven
+        self.bounds = np.concatenate([[0], cusps, [len(self.rows) - 1]])  # stretch k: rows
+        self.signs = dirs[np.minimum(self.bounds[:-1] + 1, len(dirs) - 1)]  # bounds[k]..[k+1]
+        self.stretch = 0
 
     @property
     def length(self) -> float:
         return float(self.s[-1])
 
+    @property
+    def direction(self) -> float:
+        """+1 forward, -1 reversing: the current stretch's."""
+        return float(self.signs[self.stretch])
+
+    @property
+    def stretch_end(self) -> float:
+        """Arc of the current stretch's end: the next cusp, or the path's end."""
+        return float(self.s[self.bounds[self.stretch + 1]])
+
+    def turns(self, stretch: int, s: float, v: float) -> bool:
+        """Does a car at arc s on ``stretch``, at speed v, go on along the next stretch? Yes
+        near the cusp (`CUSP_REACH`; the rows before and after it lie on top of each other)
+        at rest, or already moving the next one's way (a plan made before it stood there)."""
+        return (stretch + 1 < len(self.signs)
+                and self.s[self.bounds[stretch + 1]] - s <= CUSP_REACH
+                and (abs(v) < 1e-9 or v * self.signs[stretch + 1] > 0.0))
+
+    def advance(self, v: float) -> bool:
+        """On to the next stretch where `turns` says so; whether it did."""
+        turn = self.turns(self.stretch, float(self.s[self.cursor]), v)
+        self.stretch += turn
+        return turn
+
     def project(self, x: float, y: float) -> tuple[int, float]:
         """(index of the nearest row near the cursor, signed lateral error, left positive).
 
-        The search window runs a little back and well ahead of the last projection, so a path
-        that passes near itself (a loop) does not make the cursor jump.
+        The search window runs a little back and well ahead of the last projection, within the
+        current stretch, so a path that passes near itself (a loop, a cusp) does not make the
+        cursor jump.
         """
-        lo = max(self.cursor - 20, 0)
-        hi = min(self.cursor + 400, len(self.rows))
+        lo = max(self.cursor - 20, self.bounds[self.stretch])
+        hi = min(self.cursor + 400, self.bounds[self.stretch + 1] + 1)
         d2 = (self.rows[lo:hi, 0] - x) ** 2 + (self.rows[lo:hi, 1] - y) ** 2
         i = lo + int(np.argmin(d2))
         self.cursor = i
         rx, ry, rth = self.rows[i, :3]
-        if i + 1 < len(self.rows):  # refine on the segment towards the next row
+        if i + 1 < len(self.rows) and i < self.bounds[self.stretch + 1]:  # refine on the
+            # segment towards the next row of the stretch
             nx, ny = self.rows[i + 1, :2]
             den = (nx - rx) ** 2 + (ny - ry) ** 2
             if den > 0:
@@ -54,15 +92,19 @@ class Reference:
         return i, e
 
     def point_at(self, s: float) -> np.ndarray:
-        """The row at arc length s (the nearest row at or after it). Beyond the end the path
-        goes on straight along its last heading, so that a look-ahead near the end still
-        points along the final heading instead of cutting towards the end point."""
-        if s > self.s[-1]:
-            row = self.rows[-1].copy()
-            row[0] += (s - self.s[-1]) * math.cos(row[2])
-            row[1] += (s - self.s[-1]) * math.sin(row[2])
-            return row
+        """The row at arc length s (the nearest row at or after it)."""
         return self.rows[min(int(np.searchsorted(self.s, s)), len(self.rows) - 1)]
+
+    def target(self, s: float) -> np.ndarray:
+        """The point at arc s on the current stretch (x, y). Beyond the stretch's end it goes
+        on straight the way the car drives there, so that a look-ahead near a cusp or the end
+        still points along the final heading instead of cutting towards the end point."""
+        end = self.stretch_end
+        if s <= end:
+            return self.point_at(s)[:2]
+        row = self.rows[self.bounds[self.stretch + 1]]
+        d = (s - end) * self.direction
+        return np.array([row[0] + d * math.cos(row[2]), row[1] + d * math.sin(row[2])])
 
 
 @dataclass(frozen=True)
@@ -87,17 +129,22 @@ def steer_command(name: str, ref: Reference, i: int, e: float, e_old: float, pos
     """The wanted steering angle from controller ``name`` at the projection (i, e)."""
     x, y, th = pose
     rth, kappa = ref.rows[i, 2], ref.rows[i, 3]
+    # Reversing, the car is a forward car facing the other way that steers the other way
+    # (the kinematic model is symmetric under v → -v, θ → θ + π, δ → -δ): pure pursuit and
+    # Stanley steer that mirror car. The PD's law is the same in both (κ is the steering's).
+    d = ref.direction
+    th_m = th if d > 0 else th + math.pi
     if name == "pure-pursuit":
         ld = max(gains.lookahead_min, gains.lookahead_gain * abs(v))
-        tx, ty = ref.point_at(ref.s[i] + ld)[:2]
-        alpha = math.atan2(ty - y, tx - x) - th
+        tx, ty = ref.target(ref.s[i] + ld)
+        alpha = math.atan2(ty - y, tx - x) - th_m
         dist = max(math.hypot(tx - x, ty - y), 1e-6)
-        return math.atan(2.0 * wheelbase * math.sin(alpha) / dist)
+        return d * math.atan(2.0 * wheelbase * math.sin(alpha) / dist)
     if name == "stanley":
-        fx, fy = x + wheelbase * math.cos(th), y + wheelbase * math.sin(th)
+        fx, fy = x + wheelbase * math.cos(th_m), y + wheelbase * math.sin(th_m)
         j, ef = _front_projection(ref, i, fx, fy)
         dth = math.remainder(ref.rows[j, 2] - th, 2.0 * math.pi)
-        return dth + math.atan2(-gains.stanley_k * ef, gains.stanley_soft + abs(v))
+        return d * (dth + math.atan2(-gains.stanley_k * d * ef, gains.stanley_soft + abs(v)))
     if name == "pd":
         dth = math.remainder(th - rth, 2.0 * math.pi)
         # The lateral error's rate is v·sin(heading error) exactly; the finite difference of the
@@ -108,7 +155,7 @@ def steer_command(name: str, ref: Reference, i: int, e: float, e_old: float, pos
 
 
 def _front_projection(ref: Reference, i: int, fx: float, fy: float) -> tuple[int, float]:
-    hi = min(i + 200, len(ref.rows))
+    hi = min(i + 200, ref.bounds[ref.stretch + 1] + 1)
     d2 = (ref.rows[i:hi, 0] - fx) ** 2 + (ref.rows[i:hi, 1] - fy) ** 2
     j = i + int(np.argmin(d2))
     rx, ry, rth = ref.rows[j, :3]

@@ -119,26 +119,31 @@ class _Rollouts:
 
     def along(self, cap: float, hold: float) -> Outcome:
         """Clear time of: along the plan at speed ``cap`` for ``hold`` s, then braking; never
-        past ``stop_s``. A car still backing up brakes first, off the plan where its reverse
-        takes it, and then counts how far that is from its row as off the plan."""
+        past ``stop_s``, and at rest at each cusp before going on the other way. A car moving
+        against the plan's direction (still backing up after an evasion) brakes first, off
+        the plan where that takes it, and then counts how far that is from its row as off
+        the plan."""
         ref, a = self.ref, self.limits.max_accel
-        v, s = self.v, self.s0
+        v, s, stretch = self.v, self.s0, ref.stretch
+        stretch += ref.turns(stretch, s, v)
+        d0 = ref.signs[stretch]
         vs, ss = np.empty(self.n), np.empty(self.n)
         for k in range(self.n):
             vs[k], ss[k] = v, s
-            tk = k * STEP
-            want = cap if tk < hold else 0.0
-            want = min(want, math.sqrt(2.0 * a * max(self.stop_s - s, 0.0)))
+            d, cusp = ref.signs[stretch], ref.s[ref.bounds[stretch + 1]]
+            want = cap if k * STEP < hold else 0.0
+            want = d * min(want, math.sqrt(2.0 * a * max(min(self.stop_s, cusp) - s, 0.0)))
             nv = _toward(v, want, a * STEP)
-            s += 0.5 * (max(v, 0.0) + max(nv, 0.0)) * STEP
+            s += 0.5 * (max(d * v, 0.0) + max(d * nv, 0.0)) * STEP
             v = nv
+            stretch += ref.turns(stretch, s, v)
         j = np.clip(np.searchsorted(ref.s, ss) - 1, 0, len(ref.s) - 2)
         u = np.clip((ss - ref.s[j]) / np.maximum(ref.s[j + 1] - ref.s[j], 1e-12), 0.0, 1.0)
         poses = np.empty((self.n, 3))
         poses[:, :2] = ref.rows[j, :2] + u[:, None] * (ref.rows[j + 1, :2] - ref.rows[j, :2])
         poses[:, 2] = np.where(u < 0.5, ref.rows[j, 2], ref.rows[j + 1, 2])
         off = np.full(self.n, self.off)
-        back = int(np.argmax(vs >= 0.0))  # the sample where the car has stopped backing
+        back = int(np.argmax(vs * d0 >= 0.0))  # the sample where it no longer moves against
         if back:
             poses[:back + 1] = self._poses(vs, np.full(self.n, self.steer))[:back + 1]
             off[back + 1:] += math.dist(poses[back, :2], poses[back + 1, :2])

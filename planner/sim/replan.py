@@ -99,6 +99,9 @@ class Replanner:
         # Committed too: what the car drives while its steering swings from lock to lock. A
         # plan that bent nearer would ask the steering for what it cannot do (a drift wide).
         swing = 2.0 * vehicle.max_steer_deg / vehicle.max_steer_rate_deg_s
+        # The speed along the plan: a car still moving against it (backing up after an
+        # evasion) commits to nothing ahead.
+        v = v * self.reference.direction if self.reference is not None else v
         commit = max(v, 0.0) * (lead_s + swing) + 0.5 * a * lead_s ** 2 if v > 1e-9 else 0.0
         root, anchor, skip, s_c = self._commit_point(pose, s_now, commit)
         believed = predicted_world(self.problem.world, sensing, t + lead_s, self.uncertainty,
@@ -199,7 +202,12 @@ class Replanner:
             self.root_s = 0.0
             return Reference(path)
         lo = int(np.searchsorted(ref.s, s_now - KEEP_BEHIND))
+        # Not back across a cusp: the car's stretch is the new reference's first.
+        lo = max(lo, int(ref.bounds[ref.stretch]))
         hi = int(np.searchsorted(ref.s, s_c - 1e-9))
+        if hi > lo:  # the root is reached the way the committed rows go (a row's direction)
+            path = path.copy()
+            path[0, 4] = ref.rows[hi - 1, 4]
         rows = np.vstack([ref.rows[lo:hi], path]) if hi > lo else path
         out = Reference(rows)
         self.shift = float(ref.s[lo]) if hi > lo else s_c

@@ -337,11 +337,14 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
         want_v, want_steer, e = 0.0, steer, math.nan
         if ref is not None:
             i, e = ref.project(est[0], est[1])
+            if ref.advance(v):  # at rest at a cusp: on along the next stretch
+                i, e = ref.project(est[0], est[1])
             room = stop_s - ref.s[i] if (s.replan or not conflict) else math.inf
             if not s.replan:
                 room = ref.length - ref.s[i]
+            room = min(room, ref.stretch_end - ref.s[i])
             cap = cruise if decision is None else min(cruise, decision.manoeuvre.speed)
-            want_v = min(cap, math.sqrt(2.0 * limits.max_accel * max(room, 0.0)))
+            want_v = ref.direction * min(cap, math.sqrt(2.0 * limits.max_accel * max(room, 0.0)))
             want_steer = steer_command(s.controller, ref, i, e, e_old, est, v,
                                        limits.wheelbase, dt, gains)
         if decision is not None and not decision.on_plan:  # the guard's manoeuvre
