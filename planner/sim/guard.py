@@ -31,7 +31,7 @@ import numpy as np
 from planner._world import (CONTACT, REACH, VMAX_OBS, World, path_clearances,
                             path_moving_clearances)
 from planner.sim.control import Reference
-from planner.sim.vehicle import Limits
+from planner.sim.vehicle import Limits, toward
 
 __all__ = ["BACK_OFF", "FOLLOW", "STAND", "Decision", "Manoeuvre", "guard"]
 
@@ -133,7 +133,7 @@ class _Rollouts:
             d, cusp = ref.signs[stretch], ref.s[ref.bounds[stretch + 1]]
             want = cap if k * STEP < hold else 0.0
             want = d * min(want, math.sqrt(2.0 * a * max(min(self.stop_s, cusp) - s, 0.0)))
-            nv = _toward(v, want, a * STEP)
+            nv = toward(v, want, a * STEP)
             s += 0.5 * (max(d * v, 0.0) + max(d * nv, 0.0)) * STEP
             v = nv
             stretch += ref.turns(stretch, s, v)
@@ -160,7 +160,7 @@ class _Rollouts:
         v = self.v
         for k in range(self.n):
             vs[k] = v
-            v = _toward(v, m.speed if k * STEP < m.hold else 0.0, lim.max_accel * STEP)
+            v = toward(v, m.speed if k * STEP < m.hold else 0.0, lim.max_accel * STEP)
         return self._clear(self._poses(vs, steers), vs)
 
     def _poses(self, vs: np.ndarray, steers: np.ndarray) -> np.ndarray:
@@ -210,10 +210,6 @@ class _Rollouts:
 def _unsure(c: np.ndarray, drop: np.ndarray) -> np.ndarray:
     """Per sample pair: may the clearance reach contact between them?"""
     return (c[:-1] <= CONTACT) | (c[:-1] + c[1:] <= drop + 2.0 * CONTACT)
-
-
-def _toward(v: float, want: float, step: float) -> float:
-    return want if abs(want - v) <= step else v + math.copysign(step, want - v)
 
 
 def guard(world: World, margin: float, state, limits: Limits, ref: Reference | None, i: int,

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Limits", "arc_step", "limit_commands"]
+__all__ = ["Limits", "arc_step", "limit_commands", "toward"]
 
 
 @dataclass(frozen=True)
@@ -40,11 +40,11 @@ def limit_commands(v_prev: float, steer_prev: float, v_want: float, steer_want: 
     feasible command passes unchanged, bit for bit."""
     v = min(max(v_want, -limits.max_speed), limits.max_speed)
     s = min(max(steer_want, -limits.max_steer), limits.max_steer)
-    return (_toward(v_prev, v, limits.max_accel * dt),
-            _toward(steer_prev, s, limits.max_steer_rate * dt))
+    return (toward(v_prev, v, limits.max_accel * dt),
+            toward(steer_prev, s, limits.max_steer_rate * dt))
 
 
-def _toward(previous: float, wanted: float, step: float) -> float:
+def toward(previous: float, wanted: float, step: float) -> float:
     """``wanted`` if it is within ``step`` of ``previous``, else ``previous`` moved by ``step``
     towards it. Decided on the difference, not on ``previous ± step`` (which rounds)."""
     if abs(wanted - previous) <= step:
