@@ -113,50 +113,39 @@ def test_collision_runs_counts_contacts():
 
 
 # -- tracking ------------------------------------------------------------------------------
-@pytest.mark.parametrize("name", CONTROLLERS)
-def test_controllers_follow_a_circle(name):
-    """Two laps of a 2 m circle from 0.3 m off it, within the limits: the error settles."""
+def _round_a_circle(name: str, gear: float) -> Reference:
+    """Two laps of a 2 m circle (the steering left), forward (gear 1) or reversing (-1, so the
+    car turns right), from 0.3 m off it, within the limits: the error settles."""
     radius, L, dt = 2.0, 0.44, 0.01
     a = np.linspace(0, 4 * math.pi, 4000)
-    rows = np.column_stack([radius * np.sin(a), radius * (1 - np.cos(a)), a,
-                            np.full_like(a, 1 / radius), np.ones_like(a)])
+    rows = np.column_stack([gear * radius * np.sin(a), radius * (1 - np.cos(a)), gear * a,
+                            np.full_like(a, 1 / radius), np.full_like(a, gear)])
     ref = Reference(rows)
+    assert ref.direction == gear and len(ref.signs) == 1
     lim = Limits(L, math.radians(30), math.radians(180), 1.0, 1.0)
     x, y, th, v, s, e_old, errs = 0.0, -0.3, 0.0, 0.0, 0.0, math.nan, []
     for _ in range(2000):
         i, e = ref.project(x, y)
         want = steer_command(name, ref, i, e, e_old, (x, y, th), v, L, dt, Tracking())
-        v, s = limit_commands(v, s, 1.0, want, lim, dt)
+        v, s = limit_commands(v, s, gear, want, lim, dt)
         x, y, th = arc_step(x, y, th, v, s, L, dt)
         e_old = e
         errs.append(math.hypot(x, y - radius) - radius)
     errs = np.abs(errs)
     assert errs[:100].max() > 0.2  # it did start off the path
     assert errs[1000:].max() < 0.05, errs[1000:].max()
+    return ref
+
+
+@pytest.mark.parametrize("name", CONTROLLERS)
+def test_controllers_follow_a_circle(name):
+    _round_a_circle(name, 1.0)
 
 
 @pytest.mark.parametrize("name", CONTROLLERS)
 def test_controllers_back_along_a_circle(name):
-    """Reversing round a 2 m circle (the steering left, so the car turns right) from 0.3 m
-    off it: each controller steers the mirror car, and the error settles as it does forward."""
-    radius, L, dt = 2.0, 0.44, 0.01
-    a = np.linspace(0, 4 * math.pi, 4000)
-    rows = np.column_stack([-radius * np.sin(a), radius * (1 - np.cos(a)), -a,
-                            np.full_like(a, 1 / radius), -np.ones_like(a)])
-    ref = Reference(rows)
-    assert ref.direction == -1.0 and len(ref.signs) == 1
-    lim = Limits(L, math.radians(30), math.radians(180), 1.0, 1.0)
-    x, y, th, v, s, e_old, errs = 0.0, -0.3, 0.0, 0.0, 0.0, math.nan, []
-    for _ in range(2000):
-        i, e = ref.project(x, y)
-        want = steer_command(name, ref, i, e, e_old, (x, y, th), v, L, dt, Tracking())
-        v, s = limit_commands(v, s, -1.0, want, lim, dt)
-        x, y, th = arc_step(x, y, th, v, s, L, dt)
-        e_old = e
-        errs.append(math.hypot(x, y - radius) - radius)
-    errs = np.abs(errs)
-    assert errs[:100].max() > 0.2  # it did start off the path
-    assert errs[1000:].max() < 0.05, errs[1000:].max()
+    """Reversing, each controller steers the mirror car, and the error settles as forward."""
+    ref = _round_a_circle(name, -1.0)
     assert ref.s[ref.cursor] > 9.0  # it went round, backwards
 
 

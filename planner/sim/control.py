@@ -130,17 +130,18 @@ def steer_command(name: str, ref: Reference, i: int, e: float, e_old: float, pos
     x, y, th = pose
     rth, kappa = ref.rows[i, 2], ref.rows[i, 3]
     # Reversing, the car is a forward car facing the other way that steers the other way
-    # (the kinematic model is symmetric under v → -v, θ → θ + π, δ → -δ): pure pursuit and
-    # Stanley steer that mirror car. The PD's law is the same in both (κ is the steering's).
+    # (the kinematic model is symmetric under v → -v, θ → θ + π, δ → -δ): Stanley steers that
+    # mirror car. Pure pursuit's and the PD's laws come out the same both ways (sin(α - π)
+    # = -sin α; κ is the steering's), given a target on the stretch the car drives.
     d = ref.direction
-    th_m = th if d > 0 else th + math.pi
     if name == "pure-pursuit":
         ld = max(gains.lookahead_min, gains.lookahead_gain * abs(v))
         tx, ty = ref.target(ref.s[i] + ld)
-        alpha = math.atan2(ty - y, tx - x) - th_m
+        alpha = math.atan2(ty - y, tx - x) - th
         dist = max(math.hypot(tx - x, ty - y), 1e-6)
-        return d * math.atan(2.0 * wheelbase * math.sin(alpha) / dist)
+        return math.atan(2.0 * wheelbase * math.sin(alpha) / dist)
     if name == "stanley":
+        th_m = th if d > 0 else th + math.pi
         fx, fy = x + wheelbase * math.cos(th_m), y + wheelbase * math.sin(th_m)
         j, ef = _front_projection(ref, i, fx, fy)
         dth = math.remainder(ref.rows[j, 2] - th, 2.0 * math.pi)
