@@ -330,8 +330,6 @@ class Planner:
             driven = seg[-1, 5]
             parts.append(seg[1:])
         pts = np.vstack(parts)
-        if len(pts) > 1:  # the start is left the way the first motion goes
-            pts[0, 4] = pts[1, 4]
         pts[:, 5] /= self.options.speed
         return pts
 

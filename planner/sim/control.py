@@ -80,8 +80,7 @@ class Reference:
         i = lo + int(np.argmin(d2))
         self.cursor = i
         rx, ry, rth = self.rows[i, :3]
-        if i + 1 < len(self.rows) and i < self.bounds[self.stretch + 1]:  # refine on the
-            # segment towards the next row of the stretch
+        if i < self.bounds[self.stretch + 1]:  # refine towards the stretch's next row
             nx, ny = self.rows[i + 1, :2]
             den = (nx - rx) ** 2 + (ny - ry) ** 2
             if den > 0:
