@@ -12,6 +12,7 @@ import pytest
 
 import planner
 from app.studio._replay import TreeRecord
+from app.studio._replay_slider import NO_REPLAY
 from app.studio._tree import CHUNK, FULL_CHUNKS, OLD_SEG, SEG
 from tests._studio_tab import open_tab, wait
 
@@ -126,6 +127,24 @@ def _pieces(view, c: int) -> int:
 def _drawn_nodes(view) -> int:
     """Tree edges in the scene: the visible chunks' pieces over their pieces per edge."""
     return sum(len(h.points) // _pieces(view, c) for c, h in view._chunks.items() if h.visible)
+
+
+def test_the_slider_is_left_alone_while_the_run_goes_on():
+    """GUI updates every tick, queued behind the tree's scene updates, kept the browser
+    rendering: while the run goes on, the slider and its line stay as they are."""
+    with open_tab() as session:
+        ui, run = session.ui, session.planning
+        ui.rate.value = "200 it/s"
+        ui.budget.value = 400
+        run.resume("run")
+        assert wait(lambda: run.worker.record.iterations > 40)
+        assert run.worker.live.state == "running"
+        assert ui.replay.disabled and ui.replay_note.content == NO_REPLAY
+        assert ui.replay.max != run.worker.record.iterations
+        run.resume("pause")
+        assert wait(lambda: not ui.replay.disabled)
+        assert ui.replay.max == ui.replay.value == run.worker.record.iterations
+        assert f"of {run.worker.record.iterations:,} (the run)" in ui.replay_note.content
 
 
 def test_the_slider_redraws_the_tree_of_an_earlier_iteration_and_goes_back_to_the_run():

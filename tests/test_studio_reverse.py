@@ -16,7 +16,7 @@ import viser
 import planner
 from app.raceline import raceline_limits
 from app.studio._compare import Pins, Run
-from app.studio._live_view import PATH_RGB, LiveView
+from app.studio._live_view import BURST_TICKS, PATH_RGB, LiveView
 from app.studio._plots import SHADE, Profiles
 from app.studio._scene import REVERSE_RGB, Z, arc_length, marker_size
 from app.studio._tree import SEG
@@ -75,7 +75,8 @@ def test_reverse_pieces_are_drawn_white_and_dashed_and_each_cusp_gets_a_diamond(
     live.best_path = path.copy()
     live.best_path[:, 4] = 1.0  # a later best path that drives forward only
     live.best_version += 1
-    view.tick()
+    for _ in range(BURST_TICKS):  # the path goes out with the next burst of the tree
+        view.tick()
     assert not h["best_reverse"].visible and not h["best_cusps"].visible
     assert h["best"].visible and len(h["best"].points) == len(path) - 1
     live.best_path, live.best_version = path, live.best_version + 1

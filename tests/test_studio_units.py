@@ -9,14 +9,17 @@ import time
 
 import numpy as np
 import pytest
+import viser
 
 import planner
 from app.studio._custom import Draft, custom_scenario
 from app.studio._edit import moved_obstacle, parse_waypoints
 from app.studio._extend import RRT_LINES, STAR_LINES, StepInfo, explain, render
+from app.studio._live_view import BURST_TICKS, HEAVY_BURST_TICKS, LiveView
 from app.studio._panel import STEERINGS
 from app.studio._scenario import default_scenario
 from app.studio._tree import CHUNK, FULL_CHUNKS, OLD_PIECES, OLD_SEG, SEG, EdgeChunks
+from app.studio._worker import Live
 from planner.problem import resolve_track
 
 
@@ -82,6 +85,78 @@ def test_chunks_send_the_tail_every_time_and_rewired_chunks_a_few_at_a_time():
     assert np.allclose(first[0][1][2:4, :, :2], [[[0, 0], [2, 0]], [[2, 0], [4, 0]]])
     assert [c for c, _ in ch.take_rewired(5)] == [1]
     assert ch.take_rewired(5) == []
+
+
+def test_chunks_drawn_with_more_pieces_are_re_sent_first():
+    """A tree growing fast leaves chunks to re-level faster than they go out: a chunk still
+    drawn in full goes before one a rewire touched that is already drawn in fewer pieces."""
+    ch = EdgeChunks(seg=4, chunk=2, full_chunks=1, old_seg=2)
+    line = np.column_stack([np.linspace(0, 4, 5), np.zeros(5)])
+    for node in (0, 1):
+        ch.set(node, line)
+    assert [(c, len(seg)) for c, seg in ch.take_tail()] == [(0, 8)]  # in full: 4 pieces an edge
+    for node in (2, 3):
+        ch.set(node, line)
+    ch.take_tail()
+    assert [(c, len(seg)) for c, seg in ch.take_rewired(5)] == [(0, 4)]  # re-levelled: 2 pieces
+    ch.set(0, line * 2)  # a rewire in chunk 0
+    for node in (4, 5):  # chunk 1 falls behind the newest: to re-level
+        ch.set(node, line)
+    assert ch.new_chunks() == 1
+    assert [c for c, _ in ch.take_tail()] == [2]
+    assert ch.new_chunks() == 0 and ch.pending_rewired() == 2
+    assert [(c, len(seg)) for c, seg in ch.take_rewired(1)] == [(1, 4)]  # not the older 0
+    assert [c for c, _ in ch.take_rewired(1)] == [0]
+    assert ch.pending_rewired() == 0
+
+
+def test_a_coarse_tree_draws_its_newest_chunks_like_the_old_and_in_full_after():
+    """While a tree grows faster than the eye can follow, its newest chunks too go out in
+    OLD_SEG pieces an edge; back from coarse, they are re-sent in full."""
+    ch = EdgeChunks(seg=4, chunk=2, full_chunks=2, old_seg=2)
+    line = np.column_stack([np.linspace(0, 4, 5), np.zeros(5)])
+    for node in range(4):
+        ch.set(node, line)
+    ch.coarse = True
+    assert [(c, len(seg)) for c, seg in ch.take_tail()] == [(0, 4), (1, 4)]
+    ch.coarse = False
+    assert [(c, len(seg)) for c, seg in ch.take_rewired(5)] == [(0, 8), (1, 8)]
+
+
+def test_a_slow_tree_goes_out_five_times_a_second_a_fast_one_coarse_and_less_often():
+    """Each scene update keeps the browser rendering for a while: a tree growing by a few
+    chunks a tick goes out every HEAVY_BURST_TICKS, its newest chunks coarse; a slow one, or
+    one that stopped, every BURST_TICKS, in full."""
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    edge = np.column_stack([np.linspace(0, 1, SEG + 1), np.zeros(SEG + 1)])
+
+    def grow(live, view, per_tick: int, ticks: int) -> list[int]:
+        """The ticks (from 0) on which tree chunks went out."""
+        out = []
+        for t in range(ticks):
+            for _ in range(per_tick):
+                live.chunks.set(live.chunks.count, edge)
+            sent = view.sent_chunks
+            view.tick()
+            if view.sent_chunks > sent:
+                out.append(t)
+        return out
+
+    try:
+        slow = Live(state="running")
+        view = LiveView(server.scene, slow, (0.0, 0.0, 10.0, 10.0))
+        assert grow(slow, view, 8, 31) == [0, 5, 10, 15, 20, 25, 30]
+        assert len(view._chunks[slow.chunks.chunks - 1].points) == (8 * 31 % CHUNK) * SEG
+        fast = Live(state="running")
+        view = LiveView(server.scene, fast, (0.0, 0.0, 10.0, 10.0), root="/fast")
+        assert grow(fast, view, CHUNK, 41) == [0, HEAVY_BURST_TICKS, 2 * HEAVY_BURST_TICKS]
+        newest = fast.chunks.chunks - 1
+        assert len(view._chunks[newest].points) == CHUNK * OLD_SEG  # coarse
+        fast.state = "paused"
+        grow(fast, view, 0, BURST_TICKS + 1)
+        assert len(view._chunks[newest].points) == CHUNK * SEG  # in full again
+    finally:
+        server.stop()
 
 
 def test_a_tree_growing_faster_than_the_tail_budget_is_sent_behind_and_catches_up():

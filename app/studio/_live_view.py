@@ -1,8 +1,8 @@
 """Drawing a planner's `Live` record into one client's scene, at UI rate.
 
-`LiveView.tick` is called ~20 times a second: tail chunks every tick, rewired chunks a few per
-slow tick, fading rewire flashes, the best path when it improves, the step-mode overlay. Every
-colour it draws is named in `LEGEND`, which the panel shows.
+`LiveView.tick` is called 25 times a second: in bursts a few times a second, new and rewired
+chunks of the tree, fading rewire flashes and the best path when it improved; the step-mode
+overlay at once. Every colour it draws is named in `LEGEND`, which the panel shows.
 """
 
 from __future__ import annotations
@@ -64,16 +64,22 @@ SIDES = ((1, 1), (1, -1), (-1, 1), (-1, -1))  # a label's quadrant off its point
 # and height.
 LABEL_CHAR_PX, LABEL_PAD_PX, LABEL_H_PX = 6.5, 8.0, 18.0
 MARKER_PX = 6.0  # a marker's size in the fitted view: the scale when the camera is not known
-# The tree goes out in one burst every TREE_EVERY ticks (5 a second): the browser's cost is
-# per update it renders, more than per byte (Chromium with software WebGL drew 1.5 frames/s
-# while a chunk went out every tick, and fell to 1.5 from 20 with ten small chunks a second).
-# A burst holds at most 4 chunks of new nodes (a tree growing faster is drawn behind the
-# planner and catches up), 8 rewired or re-levelled chunks (at most FULL_CHUNKS of them in
-# full, the rest a quarter of that or less), and the rewire flashes (0.6 s each, the newest 32,
-# every other point of the edge): at most 1.2 MB/s.
+# The tree goes out in bursts, with the rewire flashes and the best path: the browser's cost is
+# per update it renders, more than per byte. Chromium with software WebGL renders for 250 ms
+# after each scene update (viser's settle window), at 135-280 ms a frame on this 2-core machine
+# while the planner takes a core: updates every 0.2 s kept it rendering without a pause, at 3-4
+# frames/s. A burst goes out every BURST_TICKS (5 a second) while the tree grows by at most
+# LIGHT_BURST chunks in that time (any pace up to a few hundred iterations a second, step mode,
+# a paused or finished run); a tree growing faster goes out every HEAVY_BURST_TICKS (0.8 s),
+# its newest chunks as coarse as the older ones (`EdgeChunks.coarse`), which leaves the
+# browser idle between bursts. A burst holds at most 4 chunks of new nodes (a tree growing
+# faster is drawn behind the planner and catches up), REWIRED_PER_TICK rewired or re-levelled
+# chunks, and the rewire flashes (0.6 s each, the newest 32, every other point of the edge).
+# A step goes out at once.
 TAIL_PIECES = 4 * CHUNK * SEG
 REWIRED_PER_TICK = 8
-TREE_EVERY = 5  # ticks
+BURST_TICKS, HEAVY_BURST_TICKS = 5, 20
+LIGHT_BURST = 2  # chunks
 FLASH_STRIDE = 2
 FLASHES_DRAWN = 32
 
@@ -222,6 +228,7 @@ class LiveView:
         self._px: dict[str, float] = {}  # each line node's width at scale 1
         self._seen = {"best": 0, "step": 0}
         self._ticks = 0
+        self._burst_tick = -HEAVY_BURST_TICKS  # the first tick draws what there is
         self.sent_chunks = 0
         self.replaying = False  # the scene shows a past iteration (`replay`), not the run
 
@@ -246,15 +253,20 @@ class LiveView:
         if self.replaying:  # the past iteration stays until `live_again`
             return
         self._ticks += 1
+        stepped = self.live.step_version != self._seen["step"]
+        since = self._ticks - self._burst_tick
         chunks = self.live.chunks
-        if self._ticks % TREE_EVERY == 0:  # one burst: the browser renders it once
+        light = self.live.state != "running" or chunks.new_chunks() <= LIGHT_BURST
+        if stepped or since >= HEAVY_BURST_TICKS or (since >= BURST_TICKS and light):
+            self._burst_tick = self._ticks  # one burst: the browser renders it once
+            chunks.coarse = not light
             self._send_chunks(chunks.take_tail(TAIL_PIECES)
                               + chunks.take_rewired(REWIRED_PER_TICK))
             self._flashes()
-        if self.live.best_version != self._seen["best"]:
-            self._seen["best"] = self.live.best_version
-            self._draw_path(self.live.best_path)
-        if self.live.step_version != self._seen["step"]:
+            if self.live.best_version != self._seen["best"]:
+                self._seen["best"] = self.live.best_version
+                self._draw_path(self.live.best_path)
+        if stepped:
             self._seen["step"] = self.live.step_version
             self._step_overlay(self.live.step)
 

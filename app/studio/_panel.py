@@ -11,6 +11,7 @@ import planner
 import tracks
 from app.studio._extend import FIRST_NOTE, render
 from app.studio._live_view import legend_html
+from app.studio._replay_slider import NO_REPLAY
 from app.studio._vehicle import APPLIED, FOOTPRINTS
 from app.studio._worker import STEP_CAP
 from planner.sim.control import CONTROLLERS
@@ -205,7 +206,7 @@ def build_panel(gui) -> Panel:
             "Replay (iteration)", 0, 1, 1, 0, disabled=True,
             hint="When the run is paused or done: the tree and the best path as they stood "
                  "after this iteration; the last one, Run or Step go back to the run")
-        replay_note = gui.add_markdown("Replay: pause or finish a run")
+        replay_note = gui.add_markdown(NO_REPLAY)
         pin = gui.add_button(
             "Pin this run", hint="Keeps this run's best path, profiles and cost over time "
                                  "drawn in a colour of its own under the next runs (4 at most: "

@@ -7,8 +7,9 @@ import numpy as np
 
 from app.studio._tree import EdgeChunks
 
-__all__ = ["ReplaySlider", "replay_md"]
+__all__ = ["NO_REPLAY", "ReplaySlider", "replay_md"]
 
+NO_REPLAY = "Replay: pause or finish a run"
 SPLIT_REPLAY = "Replay: one run at a time (leave the split to replay)"
 OLD_EDGES = 300_000  # replayed edges a tree no longer holds, kept at most (a few 10 MB)
 
@@ -18,7 +19,7 @@ class ReplaySlider:
 
     def __init__(self, ui) -> None:
         self.ui = ui
-        self._shown = -1  # the record's iterations the slider was last set to
+        self._shown: int | str = -1  # the record's iterations the slider was last set to
         self._old_edges: dict[tuple[int, int], np.ndarray] = {}  # (node, parent): its points
 
     def show(self, n: int, worker, view) -> None:
@@ -66,14 +67,21 @@ class ReplaySlider:
 
     def tick(self, worker, view, splitting: bool) -> None:
         """The slider follows the record: usable once the run is paused or done, at its end
-        while the run is shown."""
+        while the run is shown. While the run goes on it is left alone (disabled): its three
+        GUI updates a tick, arriving while scene updates waited for a frame, kept the browser
+        rendering without a pause."""
         slider, end = self.ui.replay, worker.record.iterations
-        usable = worker.live.state != "running" and end > 0 and not splitting
+        running = worker.live.state == "running"
+        usable = not running and end > 0 and not splitting
         if slider.disabled == usable:
             slider.disabled = not usable
-        if view.replaying or self._shown == end:
+        shown = "running" if running else end
+        if view.replaying or self._shown == shown:
             return
-        self._shown = end
+        self._shown = shown
+        if running:
+            self.ui.replay_note.content = NO_REPLAY
+            return
         slider.max = max(end, 1)
         slider.value = end
         self.ui.replay_note.content = (SPLIT_REPLAY if splitting
@@ -86,7 +94,7 @@ def replay_md(frame, record) -> str:
     end = record.iterations
     if frame is None:
         text = (f"Replay: iteration {end:,} of {end:,} (the run)" if end
-                else "Replay: pause or finish a run")
+                else NO_REPLAY)
     else:
         cost = "no path yet" if frame.cost is None else f"best cost {frame.cost:.4g} m"
         text = (f"Replay: iteration {frame.iteration:,} of {end:,} · {frame.nodes:,} nodes · "

@@ -13,7 +13,8 @@ grows, and step mode looks) keep ``SEG`` pieces per edge; an older chunk is re-s
 ``OLD_SEG`` pieces per edge (a chord alone would cut across the infield), and past
 ``OLD_PIECES`` of those only every k-th edge is drawn. So the drawn pieces stay under
 FULL_CHUNKS·CHUNK·SEG + OLD_PIECES whatever the tree's size; the best path and the step overlay
-are drawn in full on top.
+are drawn in full on top. While the tree grows faster than the eye can follow its edges
+(``coarse``), the newest chunks too go out in ``OLD_SEG`` pieces.
 
 Each edge also keeps its local path in segment form (kinds, signed lengths), so that a click on
 it can be answered with its steering word (`nearest`, `planner.path_word`).
@@ -65,6 +66,7 @@ class EdgeChunks:
         self._tail_dirty = False
         self._sent_n = 0  # nodes the browser had at the last tail push
         self._dirty: dict[int, None] = {}  # full chunks touched by rewires, oldest first
+        self._coarse = False
         self._lock = threading.Lock()
 
     @property
@@ -137,11 +139,28 @@ class EdgeChunks:
         with self._lock:
             return self._segments(c)
 
+    @property
+    def coarse(self) -> bool:
+        return self._coarse
+
+    @coarse.setter
+    def coarse(self, on: bool) -> None:
+        """Coarse: the newest chunks too are drawn like the older ones (a tree growing faster
+        than the eye can follow its edges); back from it, they are re-sent in full."""
+        with self._lock:
+            if on == self._coarse:
+                return
+            self._coarse = on
+            tail = self._tail_chunk()
+            for c in range(max(tail + 1 - self.full_chunks, 0), tail + 1):
+                if c in self._drawn and self._drawn[c] != self.level(c):
+                    self._dirty[c] = None
+
     def level(self, c: int) -> tuple[int, int]:
         """How chunk c is drawn now: (pieces per edge, every k-th edge)."""
         old = self._tail_chunk() + 1 - self.full_chunks  # chunks below this are old
         if c >= old:
-            return self.seg, 1
+            return (self.old_seg if self._coarse else self.seg), 1
         need = -(-old * self.chunk * self.old_seg // self.old_pieces)
         return self.old_seg, 1 << (need - 1).bit_length()  # doubling: rarely re-levelled
 
@@ -174,15 +193,26 @@ class EdgeChunks:
             return out
 
     def take_rewired(self, limit: int) -> list[tuple[int, np.ndarray]]:
-        """Up to ``limit`` full chunks to re-send, oldest first: those rewires changed, and
-        those whose level of detail changed. The browser's cost is per scene node replaced,
-        more than per piece, so the limit counts chunks."""
+        """Up to ``limit`` full chunks to re-send: those rewires changed, and those whose level
+        of detail changed; those drawn with the most pieces first (a tree growing fast leaves
+        chunks to re-level faster than they go out, and every piece drawn costs the browser
+        each frame), else oldest first. The browser's cost is per scene node replaced, more
+        than per piece, so the limit counts chunks."""
         with self._lock:
             out = []
-            for c in list(self._dirty)[:limit]:
+            for c in sorted(self._dirty, key=self._drawn_pieces, reverse=True)[:limit]:
                 del self._dirty[c]
                 out.append((c, self._segments(c)))
             return out
+
+    def _drawn_pieces(self, c: int) -> float:
+        pieces, every = self._drawn.get(c, (0, 1))
+        return pieces / every
+
+    def new_chunks(self) -> int:
+        """How many chunks new nodes went into since the tail last went out."""
+        with self._lock:
+            return self._tail_chunk() + 1 - self._sent_n // self.chunk if self._tail_dirty else 0
 
     def pending_rewired(self) -> int:
         with self._lock:
