@@ -516,7 +516,7 @@ def test_a_negative_budget_is_refused_with_the_models_message():
 
 
 def test_step_labels_never_share_a_place():
-    from app.studio._live_view import step_labels
+    from app.studio._labels import step_labels
     from app.studio._worker import Rewired, Step
 
     bounds = (-10.0, -10.0, 10.0, 10.0)  # markers of 0.12
