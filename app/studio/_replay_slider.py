@@ -19,7 +19,7 @@ class ReplaySlider:
 
     def __init__(self, ui) -> None:
         self.ui = ui
-        self._shown: int | str = -1  # the record's iterations the slider was last set to
+        self._shown: int | str = -1  # the iterations it was last set to, or "running"
         self._old_edges: dict[tuple[int, int], np.ndarray] = {}  # (node, parent): its points
 
     def show(self, n: int, worker, view) -> None:
