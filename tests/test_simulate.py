@@ -149,6 +149,39 @@ def test_controllers_back_along_a_circle(name):
     assert ref.s[ref.cursor] > 9.0  # it went round, backwards
 
 
+@pytest.mark.parametrize("name", CONTROLLERS)
+def test_the_guards_rollout_is_the_car_the_simulator_drives(name):
+    """The guard foresees the car by rolling the compiled controller out (`Tracker.rollout`):
+    tick for tick it is the simulator's own loop (projection, steering law, actuator limits,
+    exact arc), from 0.3 m off a circle with the steering at the other lock."""
+    from planner.sim.control import Tracker
+
+    radius, L, dt, sub = 2.0, 0.44, 0.01, 2
+    a = np.linspace(0, 2 * math.pi, 2000)
+    rows = np.column_stack([radius * np.sin(a), radius * (1 - np.cos(a)), a,
+                            np.full_like(a, 1 / radius), np.ones_like(a)])
+    lim = Limits(L, math.radians(30), math.radians(180), 1.0, 1.0)
+    vs = np.minimum(np.arange(150) * lim.max_accel * dt * sub, 1.0)
+    state = (0.0, -0.3, 0.0, 0.0, -lim.max_steer)
+    poses = Tracker(name).rollout(Reference(rows), state, vs, np.zeros(len(vs), np.int64), lim,
+                                  dt * sub)
+    ref = Reference(rows)
+    x, y, th, _, s = state
+    e_old, mine = math.nan, [(x, y, th)]
+    for k in range(len(vs) - 1):
+        for j in range(sub):
+            v_was, v_now = (vs[k] + (vs[k + 1] - vs[k]) * f / sub for f in (j, j + 1))
+            i, e = ref.project(x, y)
+            want = steer_command(name, ref, i, e, e_old, (x, y, th), v_was, L, dt, Tracking())
+            v, s = limit_commands(v_was, s, v_now, want, lim, dt)
+            assert v == pytest.approx(v_now, abs=1e-12)  # the speeds are the car's
+            x, y, th = arc_step(x, y, th, v_now, s, L, dt)
+            e_old = e
+        mine.append((x, y, th))
+    assert np.allclose(poses, mine, rtol=0.0, atol=1e-9)
+    assert abs(math.hypot(x, y - radius) - radius) < 0.05  # and it did get onto the circle
+
+
 def test_a_cusp_is_passed_at_rest_only():
     """Forward 1 m, then back 1 m along a line: the projection keeps to the stretch the car is
     on (the rows of both lie on top of each other) and goes on to the next only at rest."""

@@ -3,17 +3,20 @@
 All three return the wanted steering angle δ (before the actuator limits). Pure pursuit
 (Coulter 1992) steers the rear axle onto a point a look-ahead ahead; Stanley (Thrun et al. 2006)
 corrects heading and the front axle's cross-track error; the seed thesis's PD acts on the lateral
-error alone, y = p·e + d·(e − e_old)/Δt, with the path curvature as feed-forward.
+error alone, y = p·e + d·(e − e_old)/Δt, with the path curvature as feed-forward. The laws are
+compiled (`planner.sim._tracking`): the guard rolls them out along a plan every cycle.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 
 import numpy as np
 
-__all__ = ["CONTROLLERS", "Reference", "Tracking", "steer_command"]
+from planner.sim import _tracking
+from planner.sim.vehicle import Limits
+
+__all__ = ["CONTROLLERS", "Reference", "Tracker", "Tracking", "steer_command", "warm_up"]
 
 CONTROLLERS = ("pure-pursuit", "stanley", "pd")
 CUSP_REACH = 0.1  # m before a cusp within which a car at rest counts as at it
@@ -29,7 +32,7 @@ class Reference:
     """
 
     def __init__(self, rows: np.ndarray) -> None:
-        self.rows = np.asarray(rows, dtype=float)
+        self.rows = np.ascontiguousarray(rows, dtype=float)
         step = np.hypot(*np.diff(self.rows[:, :2], axis=0).T)
         self.s = np.concatenate([[0.0], np.cumsum(step)])
         self.cursor = 0
@@ -74,37 +77,13 @@ class Reference:
         current stretch, so a path that passes near itself (a loop, a cusp) does not make the
         cursor jump.
         """
-        lo = max(self.cursor - 20, self.bounds[self.stretch])
-        hi = min(self.cursor + 400, self.bounds[self.stretch + 1] + 1)
-        d2 = (self.rows[lo:hi, 0] - x) ** 2 + (self.rows[lo:hi, 1] - y) ** 2
-        i = lo + int(np.argmin(d2))
+        i, e = _tracking.project(self.rows, self.bounds, self.stretch, self.cursor, x, y)
         self.cursor = i
-        rx, ry, rth = self.rows[i, :3]
-        if i < self.bounds[self.stretch + 1]:  # refine towards the stretch's next row
-            nx, ny = self.rows[i + 1, :2]
-            den = (nx - rx) ** 2 + (ny - ry) ** 2
-            if den > 0:
-                u = ((x - rx) * (nx - rx) + (y - ry) * (ny - ry)) / den
-                if 0.0 < u < 1.0:
-                    rx, ry = rx + u * (nx - rx), ry + u * (ny - ry)
-        e = -(x - rx) * math.sin(rth) + (y - ry) * math.cos(rth)
         return i, e
 
     def point_at(self, s: float) -> np.ndarray:
         """The row at arc length s (the nearest row at or after it)."""
         return self.rows[min(int(np.searchsorted(self.s, s)), len(self.rows) - 1)]
-
-    def target(self, s: float) -> np.ndarray:
-        """The point at arc s on the current stretch (x, y). Beyond the stretch's end it goes
-        on straight the way the car drives there, so that a look-ahead near a cusp or the end
-        still points along the final heading instead of cutting towards the end point."""
-        end = self.stretch_end
-        if s <= end:
-            return self.point_at(s)[:2]
-        row = self.rows[self.bounds[self.stretch + 1]]
-        d = (s - end) * self.direction
-        return np.array([row[0] + d * math.cos(row[2]), row[1] + d * math.sin(row[2])])
-
 
 @dataclass(frozen=True)
 class Tracking:
@@ -123,40 +102,48 @@ class Tracking:
     pd_d: float = 1.2
 
 
+@dataclass(frozen=True)
+class Tracker:
+    """A controller as the car runs it: its law and gains, at ``dt`` s a control tick."""
+
+    controller: str = "pure-pursuit"
+    gains: Tracking = Tracking()
+    dt: float = 0.01
+
+    def rollout(self, ref: Reference, state, vs: np.ndarray, stretches: np.ndarray,
+                limits: Limits, step: float) -> np.ndarray:
+        """The poses (n × 3) of the car from ``state`` (x, y, θ, v, δ), ``step`` s apart, at
+        the speeds ``vs``, tracking ``ref`` on ``stretches`` (per sample): where the steering's
+        rate and lock let it be, not where the plan is."""
+        x, y, th, _, steer = state
+        return _tracking.rollout(CONTROLLERS.index(self.controller), ref.rows, ref.s,
+                                 ref.bounds, ref.signs, stretches, ref.cursor, x, y, th, steer,
+                                 vs, limits.wheelbase, limits.max_steer, limits.max_steer_rate,
+                                 self.dt, max(1, round(step / self.dt)), astuple(self.gains))
+
+
 def steer_command(name: str, ref: Reference, i: int, e: float, e_old: float, pose, v: float,
                   wheelbase: float, dt: float, gains: Tracking) -> float:
-    """The wanted steering angle from controller ``name`` at the projection (i, e)."""
+    """The wanted steering angle from controller ``name`` at the projection (i, e).
+
+    Reversing, the car is a forward car facing the other way that steers the other way (the
+    kinematic model is symmetric under v → -v, θ → θ + π, δ → -δ): Stanley steers that mirror
+    car. Pure pursuit's and the PD's laws come out the same both ways (sin(α - π) = -sin α;
+    κ is the steering's), given a target on the stretch the car drives.
+    """
+    if name not in CONTROLLERS:
+        raise ValueError(f"unknown controller '{name}' (use one of {', '.join(CONTROLLERS)})")
     x, y, th = pose
-    rth, kappa = ref.rows[i, 2], ref.rows[i, 3]
-    # Reversing, the car is a forward car facing the other way that steers the other way
-    # (the kinematic model is symmetric under v → -v, θ → θ + π, δ → -δ): Stanley steers that
-    # mirror car. Pure pursuit's and the PD's laws come out the same both ways (sin(α - π)
-    # = -sin α; κ is the steering's), given a target on the stretch the car drives.
-    d = ref.direction
-    if name == "pure-pursuit":
-        ld = max(gains.lookahead_min, gains.lookahead_gain * abs(v))
-        tx, ty = ref.target(ref.s[i] + ld)
-        alpha = math.atan2(ty - y, tx - x) - th
-        dist = max(math.hypot(tx - x, ty - y), 1e-6)
-        return math.atan(2.0 * wheelbase * math.sin(alpha) / dist)
-    if name == "stanley":
-        th_m = th if d > 0 else th + math.pi
-        fx, fy = x + wheelbase * math.cos(th_m), y + wheelbase * math.sin(th_m)
-        j, ef = _front_projection(ref, i, fx, fy)
-        dth = math.remainder(ref.rows[j, 2] - th, 2.0 * math.pi)
-        return d * (dth + math.atan2(-gains.stanley_k * d * ef, gains.stanley_soft + abs(v)))
-    if name == "pd":
-        dth = math.remainder(th - rth, 2.0 * math.pi)
-        # The lateral error's rate is v·sin(heading error) exactly; the finite difference of the
-        # seed's PD is kept for its first tick only (e_old is NaN then).
-        de = v * math.sin(dth) if math.isnan(e_old) else (e - e_old) / dt
-        return math.atan(wheelbase * kappa) - gains.pd_p * e - gains.pd_d * de
-    raise ValueError(f"unknown controller '{name}' (use one of {', '.join(CONTROLLERS)})")
+    return _tracking.steer(CONTROLLERS.index(name), ref.rows, ref.s, ref.bounds, ref.signs,
+                           ref.stretch, i, e, e_old, x, y, th, v, wheelbase, dt,
+                           astuple(gains))
 
 
-def _front_projection(ref: Reference, i: int, fx: float, fy: float) -> tuple[int, float]:
-    hi = min(i + 200, ref.bounds[ref.stretch + 1] + 1)
-    d2 = (ref.rows[i:hi, 0] - fx) ** 2 + (ref.rows[i:hi, 1] - fy) ** 2
-    j = i + int(np.argmin(d2))
-    rx, ry, rth = ref.rows[j, :3]
-    return j, -(fx - rx) * math.sin(rth) + (fy - ry) * math.cos(rth)
+def warm_up() -> None:
+    """Load (or compile) the tracking kernels once, so that no cycle time includes it."""
+    rows = np.zeros((3, 5))
+    rows[:, 0], rows[:, 4] = (0.0, 0.1, 0.2), 1.0
+    ref = Reference(rows)
+    for name in CONTROLLERS:
+        Tracker(name).rollout(ref, (0.0, 0.0, 0.0, 0.0, 0.0), np.zeros(2), np.zeros(2, np.int64),
+                              Limits(0.3, 0.5, 1.0, 1.0, 1.0), 0.02)
