@@ -23,17 +23,23 @@ def _wrap(a):
     return a - _TWO_PI * math.floor(a / _TWO_PI + 0.5)
 
 
-@njit(cache=True)
-def project(rows, bounds, stretch, cursor, x, y):
-    """(nearest row from a little behind to well ahead of ``cursor``, within the stretch;
-    signed lateral error, left positive), refined towards the stretch's next row."""
-    lo = max(cursor - 20, bounds[stretch])
-    hi = min(cursor + 400, bounds[stretch + 1] + 1)
+@njit(cache=True, inline="always")
+def _nearest(rows, lo, hi, x, y):
+    """The row in [lo, hi) nearest to (x, y) (the first of equals)."""
     i, best = lo, math.inf
     for j in range(lo, hi):
         d2 = (rows[j, 0] - x) ** 2 + (rows[j, 1] - y) ** 2
         if d2 < best:
             i, best = j, d2
+    return i
+
+
+@njit(cache=True)
+def project(rows, bounds, stretch, cursor, x, y):
+    """(nearest row from a little behind to well ahead of ``cursor``, within the stretch;
+    signed lateral error, left positive), refined towards the stretch's next row."""
+    i = _nearest(rows, max(cursor - 20, bounds[stretch]),
+                 min(cursor + 400, bounds[stretch + 1] + 1), x, y)
     rx, ry, rth = rows[i, 0], rows[i, 1], rows[i, 2]
     if i < bounds[stretch + 1]:
         nx, ny = rows[i + 1, 0], rows[i + 1, 1]
@@ -72,12 +78,7 @@ def steer(law, rows, s, bounds, signs, stretch, i, e, e_old, x, y, th, v, wheelb
     if law == STANLEY:  # the mirror car's front axle when reversing
         th_m = th if d > 0 else th + math.pi
         fx, fy = x + wheelbase * math.cos(th_m), y + wheelbase * math.sin(th_m)
-        hi = min(i + 200, bounds[stretch + 1] + 1)
-        j, best = i, math.inf
-        for k in range(i, hi):
-            d2 = (rows[k, 0] - fx) ** 2 + (rows[k, 1] - fy) ** 2
-            if d2 < best:
-                j, best = k, d2
+        j = _nearest(rows, i, min(i + 200, bounds[stretch + 1] + 1), fx, fy)
         ef = -(fx - rows[j, 0]) * math.sin(rows[j, 2]) + (fy - rows[j, 1]) * math.cos(rows[j, 2])
         dth = _wrap(rows[j, 2] - th)
         return d * (dth + math.atan2(-gains[2] * d * ef, gains[3] + abs(v)))

@@ -13,9 +13,10 @@ clear, the car is in danger: the guard picks, from the state now, the manoeuvre 
 clear longest — brake along the plan, brake while swerving, swerve at speed, go on straight, or
 back up — and the car executes it until the next cycle decides again.
 
-Rollouts are the car's own model (`vehicle.arc_step` with the actuator limits, at
-``STEP`` s); along the plan the car is where the reference is at the driven arc (it tracks it to
-a few cm, within the planning margin). Between two samples k and k + 1 the clearance drops by at
+Rollouts are the car's own model (exact arcs with the actuator limits, at ``STEP`` s); along
+the plan it is the tracking controller rolled out from where the car is (`control.Tracker`), so
+a car whose steering is still swinging, or that lags outside a bend it takes at full lock, is
+foreseen where it will drive, not where the plan is. Between two samples k and k + 1 the clearance drops by at
 most (|v|·(1 + reach/ρ) + the movers' top speed and growth)·STEP, so two samples whose
 clearances add up to more than that cannot hide a contact between them.
 """
@@ -30,7 +31,7 @@ import numpy as np
 
 from planner._world import (CONTACT, REACH, VMAX_OBS, World, path_clearances,
                             path_moving_clearances)
-from planner.sim.control import Reference
+from planner.sim.control import CUSP_REACH, Reference, Tracker
 from planner.sim.vehicle import Limits, toward
 
 __all__ = ["BACK_OFF", "FOLLOW", "STAND", "Decision", "Manoeuvre", "guard"]
@@ -80,11 +81,13 @@ class Outcome(NamedTuple):
 class Decision:
     """What the car does until the next cycle. ``clear_s``: how long the chosen manoeuvre
     stays clear (inf: over the whole horizon); ``danger``: no commitment along the plan was
-    clear, so this is an evasive choice."""
+    clear, so this is an evasive choice; ``unstick``: the car had stood, not by plan, and
+    this gets it going (`UNSTICK_S`)."""
 
     manoeuvre: Manoeuvre
     clear_s: float
     danger: bool
+    unstick: bool = False
 
     @property
     def on_plan(self) -> bool:
@@ -96,11 +99,11 @@ class _Rollouts:
 
     def __init__(self, world: World, margin: float, state, limits: Limits,
                  ref: Reference | None, i: int, stop_s: float, rho: float,
-                 done_s: float = math.inf, off: float = 0.0) -> None:
+                 done_s: float, tracker: Tracker) -> None:
         self.world, self.margin, self.limits, self.ref, self.stop_s = (world, margin, limits,
                                                                       ref, stop_s)
+        self.state, self.tracker = state, tracker
         self.reachable: World | None = None  # reachable sets the car must be at rest before
-        self.off = off  # how far the car is from the plan beyond the margin (along the plan)
         likely = world.m_grow.copy()
         likely[:, 1:3] = 0.0  # no growth: each mover where its sensed velocity takes it
         self.likely = world._replace(m_grow=likely)
@@ -119,17 +122,16 @@ class _Rollouts:
 
     def along(self, cap: float, hold: float) -> Outcome:
         """Clear time of: along the plan at speed ``cap`` for ``hold`` s, then braking; never
-        past ``stop_s``, and at rest at each cusp before going on the other way. A car moving
-        against the plan's direction (still backing up after an evasion) brakes first, off
-        the plan where that takes it, and then counts how far that is from its row as off
-        the plan."""
+        past ``stop_s``, and at rest at each cusp before going on the other way. The speeds
+        follow the plan's arc; the poses are the controller's (a car still backing up after
+        an evasion brakes first, off the plan where that takes it)."""
         ref, a = self.ref, self.limits.max_accel
         v, s, stretch = self.v, self.s0, ref.stretch
         stretch += ref.turns(stretch, s, v)
-        d0 = ref.signs[stretch]
         vs, ss = np.empty(self.n), np.empty(self.n)
+        stretches = np.empty(self.n, np.int64)
         for k in range(self.n):
-            vs[k], ss[k] = v, s
+            vs[k], ss[k], stretches[k] = v, s, stretch
             d, cusp = ref.signs[stretch], ref.s[ref.bounds[stretch + 1]]
             want = cap if k * STEP < hold else 0.0
             want = d * min(want, math.sqrt(2.0 * a * max(min(self.stop_s, cusp) - s, 0.0)))
@@ -137,18 +139,10 @@ class _Rollouts:
             s += 0.5 * (max(d * v, 0.0) + max(d * nv, 0.0)) * STEP
             v = nv
             stretch += ref.turns(stretch, s, v)
-        j = np.clip(np.searchsorted(ref.s, ss) - 1, 0, len(ref.s) - 2)
-        u = np.clip((ss - ref.s[j]) / np.maximum(ref.s[j + 1] - ref.s[j], 1e-12), 0.0, 1.0)
-        poses = np.empty((self.n, 3))
-        poses[:, :2] = ref.rows[j, :2] + u[:, None] * (ref.rows[j + 1, :2] - ref.rows[j, :2])
-        poses[:, 2] = np.where(u < 0.5, ref.rows[j, 2], ref.rows[j + 1, 2])
-        off = np.full(self.n, self.off)
-        back = int(np.argmax(vs * d0 >= 0.0))  # the sample where it no longer moves against
-        if back:
-            poses[:back + 1] = self._poses(vs, np.full(self.n, self.steer))[:back + 1]
-            off[back + 1:] += math.dist(poses[back, :2], poses[back + 1, :2])
         end = int(np.searchsorted(ss, self.done_s)) + 1  # the run ends in the goal
-        return self._clear(poses[:end], vs[:end], off[:end])
+        poses = self.tracker.rollout(ref, self.state, vs[:end], stretches[:end], self.limits,
+                                     STEP)
+        return self._clear(poses, vs[:end])
 
     def free(self, m: Manoeuvre) -> Outcome:
         """Clear time of an open-loop manoeuvre: steering towards ``m.steer`` at the rate
@@ -177,30 +171,28 @@ class _Rollouts:
         poses[:, 2] = th
         return poses
 
-    def _clear(self, poses: np.ndarray, vs: np.ndarray, off=0.0) -> Outcome:
+    def _clear(self, poses: np.ndarray, vs: np.ndarray) -> Outcome:
         """The time of the first sample pair that may hide a contact (inf: none): with the
         movers as believed (grown, with the margin), with the static world as it is; if there
-        is one, also with the movers' likely futures. ``off`` (m, or per sample): the car may be
-        this far from the poses (it is off the plan it tracks), so every clearance counts that
-        much less."""
+        is one, also with the movers' likely futures."""
         n = len(poses)
         samples = np.zeros((n, 6))
         samples[:, :3] = poses
         drive = np.abs(vs[:-1]) * self.reach * STEP
         samples[:, 5] = math.nan  # static obstacles only
-        static = _unsure(path_clearances(self.world, samples, True) + self.margin - off, drive)
+        static = _unsure(path_clearances(self.world, samples, True) + self.margin, drive)
         samples[:, 5] = self.t[:n]
         closing = drive + self.closing[:n - 1]
-        unsure = _unsure(path_moving_clearances(self.world, samples) - off, closing) | static
+        unsure = _unsure(path_moving_clearances(self.world, samples), closing) | static
         if self.reachable is not None:  # passive safety: at rest before a mover may reach it
             moving = np.maximum(np.abs(vs[:-1]), np.abs(vs[1:])) > 0.0
-            unsure |= moving & _unsure(path_moving_clearances(self.reachable, samples) - off,
+            unsure |= moving & _unsure(path_moving_clearances(self.reachable, samples),
                                        drive + self.reachable.geo[VMAX_OBS] * STEP)
         bad = np.flatnonzero(unsure)
         if len(bad) == 0:
             return Outcome(math.inf, True)
         k = bad[0]
-        likely = np.flatnonzero(_unsure(path_moving_clearances(self.likely, samples) - off,
+        likely = np.flatnonzero(_unsure(path_moving_clearances(self.likely, samples),
                                         closing) | static)
         j = likely[0] if len(likely) else k
         return Outcome(float(self.t[k]), max(abs(vs[j]), abs(vs[j + 1])) < 1e-9,
@@ -212,45 +204,90 @@ def _unsure(c: np.ndarray, drop: np.ndarray) -> np.ndarray:
     return (c[:-1] <= CONTACT) | (c[:-1] + c[1:] <= drop + 2.0 * CONTACT)
 
 
+def _commitments(cruise: float, commit: float):
+    """(manoeuvre, s held) along the plan, fastest first: each speed cap for the commitment
+    and then for a while longer (`GO_ON`), braking last."""
+    for share in CAPS:
+        m = Manoeuvre(FOLLOW if share == 1.0 else "slow" if share > 0 else "brake",
+                      share * cruise)
+        for go_on in GO_ON if share > 0.0 else (0.0,):
+            yield m, commit + go_on
+
+
+def _evasive(v: float, cruise: float, limits: Limits, reverse: bool) -> list[Manoeuvre]:
+    """The manoeuvres off the plan: braking while swerving, swerving at speed, going on
+    straight, and backing up where the car may."""
+    s_max = limits.max_steer
+    evasive = [Manoeuvre("brake-left", 0.0, steer=s_max),
+               Manoeuvre("brake-right", 0.0, steer=-s_max),
+               Manoeuvre("swerve-left", max(v, 0.5 * cruise), EVADE_S, s_max),
+               Manoeuvre("swerve-right", max(v, 0.5 * cruise), EVADE_S, -s_max),
+               Manoeuvre("go-on", limits.max_speed, EVADE_S, 0.0)]
+    if reverse:
+        evasive += [Manoeuvre("back-up", -cruise, EVADE_S, 0.0),
+                    Manoeuvre("back-up-left", -cruise, EVADE_S, s_max),
+                    Manoeuvre("back-up-right", -cruise, EVADE_S, -s_max)]
+    return evasive
+
+
+def _unstick(r: _Rollouts, cruise: float, commit: float, reverse: bool,
+             back_off: bool) -> Decision | None:
+    """A car that has stood a while, not by plan, gets going, judged without the reachable
+    sets (a mover parked beside the way, seen to turn once, never frees it): along a plan
+    that leads on (a fresh plan for a car that stood without one is followed, not swerved
+    from); else, as a forward-only planner finds no way round an obstacle right in
+    front, backing off a little once; else, if a plan leads on, by the first forward
+    manoeuvre off it that is clear throughout (a plan timed for a car at speed can pass a
+    mover's grown prediction that a car setting off from rest cannot). None: it stands."""
+    leads_on = r.ref is not None and r.stop_s - r.s0 > CUSP_REACH  # not a wait where it is
+    if leads_on:
+        for m, hold in _commitments(cruise, commit):
+            if m.speed > 0.0 and r.along(m.speed, hold).clear_s == math.inf:
+                return Decision(m, math.inf, False, unstick=True)
+    moves = [Manoeuvre(BACK_OFF, -0.5 * cruise, steer=0.0)] if reverse and back_off else []
+    if leads_on:
+        moves += [m for m in _evasive(r.v, cruise, r.limits, False) if m.speed > 0.0]
+    for m in moves:
+        if r.free(m).clear_s == math.inf:
+            return Decision(m, math.inf, m.name != BACK_OFF, unstick=True)
+    return None
+
+
 def guard(world: World, margin: float, state, limits: Limits, ref: Reference | None, i: int,
           stop_s: float, cruise: float, commit: float, rho: float, reverse: bool,
-          stuck: bool = False, done_s: float = math.inf, off: float = 0.0,
-          reach: World | None = None) -> Decision:
+          stuck: bool = False, done_s: float = math.inf, reach: World | None = None,
+          tracker: Tracker | None = None, back_off: bool = True) -> Decision:
     """The car's manoeuvre until the next decision, ``commit`` s from now.
 
     ``state``: (x, y, θ, v, δ) now; ``ref``/``i``: the plan and the car's row on it (None: no
     plan yet); ``stop_s``: the arc where the plan wants the car at rest (a planned wait or the
     plan's end); ``world``: the grown prediction with planner time 0 now, inflated by
     ``margin`` (which the static check gives back: the car may come as near a wall as it is);
-    ``stuck``: the car has stood, not by plan, for a while — a forward-only planner finds no
-    way round an obstacle right in front, so it backs off a little if that is clear;
+    ``stuck``: the car has stood, not by plan, for a while: it gets going if it can
+    (`_unstick`); ``back_off``: whether it may back off then (once, until it has driven on);
     ``done_s``: the arc where the plan enters the goal and the run ends (inf: none) — a goal in
     a stream of traffic is reached, not stood in, so the check along the plan ends there;
-    ``off``: how far the car is from its row on the plan beyond what the margin allows: the
-    checks along the plan count it off every clearance (a car that lags outside a tight
-    turn stays outside it), the open-loop manoeuvres start from where the car is;
     ``reach``: the movers' reachable sets (`planner.sim.predict.reach_world`, inflated like
     ``world``): a commitment along the plan must have the car at rest before one of them
     reaches it; if only that fails, the car brakes along the plan (a walker may turn into
-    it). Backing off when stuck and the evasive manoeuvres are judged without them.
+    it). Getting unstuck and the evasive manoeuvres are judged without them;
+    ``tracker``: the controller the car tracks the plan with (None: pure pursuit at 100 Hz),
+    rolled out along it.
     """
-    r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho, done_s, off)
+    r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho, done_s,
+                  tracker or Tracker())
     tried: list[tuple[Outcome, Manoeuvre]] = []
-    if stuck and reverse:  # a forward-only plan finds no way on: make room behind
-        m = Manoeuvre(BACK_OFF, -0.5 * cruise, steer=0.0)
-        out = r.free(m)
-        if out.clear_s == math.inf:
-            return Decision(m, out.clear_s, False)
+    if stuck:
+        unstick = _unstick(r, cruise, commit, reverse, back_off)
+        if unstick is not None:
+            return unstick
     r.reachable = reach
     if ref is not None:
-        for share in CAPS:
-            m = Manoeuvre(FOLLOW if share == 1.0 else "slow" if share > 0 else "brake",
-                          share * cruise)
-            for go_on in GO_ON if share > 0.0 else (0.0,):
-                out = r.along(m.speed, commit + go_on)
-                if out.clear_s == math.inf:
-                    return Decision(m, out.clear_s, False)
-                tried.append((out, m))
+        for m, hold in _commitments(cruise, commit):
+            out = r.along(m.speed, hold)
+            if out.clear_s == math.inf:
+                return Decision(m, out.clear_s, False)
+            tried.append((out, m))
         if reach is not None:  # clear but for the reachable sets: brake (passive safety)
             r.reachable = None
             if r.along(0.0, commit).clear_s == math.inf:
@@ -266,17 +303,7 @@ def guard(world: World, margin: float, state, limits: Limits, ref: Reference | N
     # plan tried above keep their outcomes with the sets: where a walker may turn into the
     # plan, a swerve clear of its likely future is preferred to driving on along it.
     r.reachable = None
-    s_max = limits.max_steer
-    evasive = [Manoeuvre("brake-left", 0.0, steer=s_max),
-               Manoeuvre("brake-right", 0.0, steer=-s_max),
-               Manoeuvre("swerve-left", max(r.v, 0.5 * cruise), EVADE_S, s_max),
-               Manoeuvre("swerve-right", max(r.v, 0.5 * cruise), EVADE_S, -s_max),
-               Manoeuvre("go-on", limits.max_speed, EVADE_S, 0.0)]
-    if reverse:
-        evasive += [Manoeuvre("back-up", -cruise, EVADE_S, 0.0),
-                    Manoeuvre("back-up-left", -cruise, EVADE_S, s_max),
-                    Manoeuvre("back-up-right", -cruise, EVADE_S, -s_max)]
-    for m in evasive:
+    for m in _evasive(r.v, cruise, limits, reverse):
         tried.append((r.free(m), m))
     out, m = max(tried, key=lambda om: om[0].rank)  # the first of the best
     return Decision(m, out.clear_s, True)

@@ -22,7 +22,8 @@ from planner.options import TIMINGS, PlanOptions
 from planner.problem import Problem, compile_problem, resolve_track
 from planner.rrt import warm_up
 from planner.scenario import Scenario
-from planner.sim.control import CONTROLLERS, Reference, Tracking, steer_command
+from planner.sim.control import CONTROLLERS, Reference, Tracker, steer_command
+from planner.sim.control import warm_up as warm_up_tracking
 from planner.sim.fsm import Machine
 from planner.sim.fsm.runtime import Behaviour
 from planner.sim.guard import BACK_OFF, FOLLOW, STAND, UNSTICK_S, Decision, guard
@@ -162,7 +163,9 @@ def _goal_arc(problem: Problem, ref: Reference) -> float:
 # all of it, pass its check with room to spare.
 GUARD_MARGIN = 0.5
 OFF_PLAN = 0.3  # m from the plan beyond which the car no longer counts as on it
-STUCK_S = 2.0  # s at rest, not by plan, before the car backs off once (`guard.BACK_OFF`)
+# The car is stuck when it has stayed this long within this distance of a spot, not by plan (a
+# car that edges to and fro is as stuck as one at rest); it then gets going (`Decision.unstick`).
+STUCK_S, STUCK_M = 2.0, 0.1
 # Per-tick guard codes in the log's ``guard`` column.
 GUARD_CODES = {"follow": 0, "wait": 1, "slow": 2, "brake": 3, "evade": 4, "back-off": 5}
 
@@ -182,8 +185,8 @@ def _state(decision: Decision | None, waiting: bool) -> str:
 def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertainty,
             lanes: Lanes | None, s: SimSettings,
             limits: Limits, state, ref: Reference | None, stop_s: float, cruise: float,
-            commit: float, stuck: bool, done_s: float, agility: Agility,
-            known: np.ndarray) -> Decision:
+            commit: float, stuck: bool, back_off: bool, done_s: float, agility: Agility,
+            known: np.ndarray, tracker: Tracker) -> Decision:
     """The guard's decision at a cycle's start, in the world the car believes in now (grown
     predictions, the planning margin; the bare car where it already is inside the margin),
     the car at rest before a mover that turns at once could reach it (`reach_world`).
@@ -193,12 +196,11 @@ def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertain
     margin = GUARD_MARGIN * s.margin
     margin = margin if clearance(believed, state[0], state[1], 0.0) > margin else 0.0
     i = ref.project(state[0], state[1])[0] if ref is not None else 0
-    off = math.dist(state[:2], ref.rows[i, :2]) if ref is not None else 0.0
-    if off > OFF_PLAN:
+    if ref is not None and math.dist(state[:2], ref.rows[i, :2]) > OFF_PLAN:
         ref = None  # the car is not where the plan is: checks along it would be fiction
     return guard(inflated(believed, margin), margin, state, limits, ref, i, stop_s, cruise,
-                 commit, problem.rho, s.reverse, stuck, done_s, max(off - margin, 0.0),
-                 inflated(reach, margin) if reach is not None else None)
+                 commit, problem.rho, s.reverse, stuck, done_s,
+                 inflated(reach, margin) if reach is not None else None, tracker, back_off)
 
 
 def _lap_counter(scenario: Scenario, problem: Problem, s: SimSettings, load_track):
@@ -225,6 +227,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     counter = _lap_counter(scenario, problem, s, load_track)  # before the slow warm-up
     warm_up()
     warm_up_replanning()
+    warm_up_tracking()
     if s.timing == "optimal":
         warm_up_timing()
     vehicle = scenario.vehicle
@@ -252,7 +255,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                          margin=s.margin, uncertainty=uncertainty, lanes=lanes)
 
     replanner = new_replanner()
-    gains = Tracking()
+    tracker = Tracker(s.controller, dt=dt)
     # Heading noise as if θ came from two position fixes a wheelbase apart.
     pose_sigma = (s.noise, s.noise, math.sqrt(2.0) * s.noise / limits.wheelbase)
     x, y, th = problem.start
@@ -269,7 +272,8 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
     # The guard's decision (FOLLOW until the first): what the car does until the next cycle.
     guarded = fsm is None and s.replan
     decision, decided_at, codes, evasions, brakes = None, 0.0, [], 0, 0
-    planless_since = backed_at = 0.0  # since when the car has stood without a way on
+    planless_since = unstuck_at = 0.0  # since when the car has stayed near stood_at, not by plan
+    stood_at = problem.start[:2]
     backed_off = False
     rows, lat = [], []
     tree_of, tree = None, None  # the planner last shown to the observer, and its copy
@@ -303,20 +307,24 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
             checked = time.perf_counter()
             if guarded:
                 before = decision
-                backing = (before is not None and before.manoeuvre.name == BACK_OFF
-                           and t - backed_at < UNSTICK_S)  # a back-off runs its course
-                if planned or (abs(v) > 1e-9 and not backing):
-                    planless_since = t  # not stuck: waiting by plan, or driving
+                unsticking = (before is not None and before.unstick
+                              and t - unstuck_at < UNSTICK_S)  # runs its course
+                if planned or (math.dist(est[:2], stood_at) > STUCK_M and not unsticking):
+                    stood_at, planless_since = est[:2], t  # not stuck: waiting by plan, or driving
                     backed_off = backed_off and v <= 0.0
                 decision = _decide(problem, sensing, t, uncertainty, lanes, s, limits,
                                    (*est, v, steer),
                                    ref, stop_s, cruise, lead,
-                                   backing or (not backed_off
-                                               and t - planless_since >= STUCK_S), done_s,
-                                   agility, known)
+                                   unsticking or t - planless_since >= STUCK_S,
+                                   not backed_off or (unsticking
+                                                      and before.manoeuvre.name == BACK_OFF),
+                                   done_s,
+                                   agility, known, tracker)
                 decided_at = t
-                if decision.manoeuvre.name == BACK_OFF and not backing:
-                    backed_at, backed_off = t, True  # once, until the car drives on again
+                if decision.unstick and not unsticking:
+                    unstuck_at = t
+                # Backs off once, until the car drives on again.
+                backed_off = backed_off or decision.manoeuvre.name == BACK_OFF
                 brakes += decision.manoeuvre.name == "brake" and (
                     before is None or before.manoeuvre.name != "brake")
                 evasions += not decision.on_plan and decision.danger and (
@@ -346,7 +354,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
             cap = cruise if decision is None else min(cruise, decision.manoeuvre.speed)
             want_v = ref.direction * min(cap, math.sqrt(2.0 * limits.max_accel * max(room, 0.0)))
             want_steer = steer_command(s.controller, ref, i, e, e_old, est, v,
-                                       limits.wheelbase, dt, gains)
+                                       limits.wheelbase, dt, tracker.gains)
         if decision is not None and not decision.on_plan:  # the guard's manoeuvre
             m = decision.manoeuvre
             want_v = m.speed if t - decided_at < m.hold else 0.0
