@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from planner._jit import njit
+from planner.sim.vehicle import toward
 
 PURE_PURSUIT, STANLEY, PD = 0, 1, 2  # the laws, in `planner.sim.control.CONTROLLERS` order
 _TWO_PI = 2.0 * math.pi
@@ -87,11 +88,7 @@ def steer(law, rows, s, bounds, signs, stretch, i, e, e_old, x, y, th, v, wheelb
     return math.atan(wheelbase * rows[i, 3]) - gains[4] * e - gains[5] * de
 
 
-@njit(cache=True, inline="always")
-def _toward(previous, wanted, step):
-    if abs(wanted - previous) <= step:
-        return wanted
-    return previous + math.copysign(step, wanted - previous)
+_toward = njit(cache=True, inline="always")(toward)  # the steering's rate, as the car has it
 
 
 @njit(cache=True)
