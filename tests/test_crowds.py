@@ -486,3 +486,61 @@ def test_a_walker_turning_back_ahead_of_the_car_no_longer_hits_it():
     s = run.summary
     assert s["collisions"] == 0 and s["reached_goal"], s
 
+
+
+@settings(max_examples=80, deadline=None)
+@given(speed=st.floats(0.3, 1.5), turn=st.floats(0.0, 2 * math.pi), after=st.floats(0.0, 1.0),
+       share=st.floats(0.05, 1.0))
+def test_a_walker_sensed_mid_turn_is_also_tried_at_its_new_velocity(speed, turn, after, share):
+    """A finite difference across a turn blends the velocities before and after it. The
+    velocities tried besides the sensed one lie on the ray from the old velocity through the
+    sensed one, the last at the walker's top speed; the true new velocity lies between the
+    sensed one and that end (a walker that turned back mid-interval, sensed standing, is
+    tried walking back)."""
+    from planner.sim.predict import Agility, turn_velocities
+
+    v0 = np.array([speed, 0.0])
+    v1 = after * speed * np.array([math.cos(turn), math.sin(turn)])
+    sensed = (1.0 - share) * v0 + share * v1
+    seen = Agility.none(1)
+    u = Uncertainty()
+    seen.see(_walker(0.0, (0.0, 0.0), v0), u)
+    seen.see(_walker(0.1, (0.1, 0.0), sensed), u)
+    tried = turn_velocities(_walker(0.1, (0.1, 0.0), sensed), seen)
+    if not seen.jumped[0]:
+        assert tried == []
+        return
+    far = tried[-1][0]
+    assert np.hypot(*far) == pytest.approx(speed, abs=1e-9)  # the top speed seen
+    ray, out = sensed - v0, far - v0
+    assert abs(ray[0] * out[1] - ray[1] * out[0]) <= 1e-9 * max(1.0, np.hypot(*ray))
+    # v1 = sensed + λ·(far − sensed), 0 ≤ λ ≤ 1
+    lam = np.dot(v1 - sensed, far - sensed) / max(np.dot(far - sensed, far - sensed), 1e-18)
+    assert -1e-9 <= lam <= 1 + 1e-9
+    assert np.allclose(sensed + lam * (far - sensed), v1, atol=1e-6)
+
+
+def test_a_walker_sensed_mid_turn_is_not_braked_for_in_its_way_back():
+    """crowd_square variant (30 Hz, optimal, seed 1): a walker ahead, just beside the car's
+    way, turned back between two sensings and was sensed standing; in danger, the car braked
+    steering towards it, as a standing walker would never come, and was walked into at rest.
+    Tried also walking back, it is evaded: the car swerves out of its way."""
+    from planner.sim.guard import guard
+    from planner.sim.predict import Agility, likely_worlds
+
+    base, ref, limits = _lane()
+    u = Uncertainty()
+    seen = Agility.none(1)
+    seen.see(_walker(-0.1, (6.9, 5.3), (1.0, 0.0)), u)  # walking away, 0.3 m left of the way
+    sensing = _walker(0.0, (7.0, 5.3), (0.0, 0.0))  # turned back mid-interval: seen standing
+    seen.see(sensing, u)
+    believed = predicted_world(base, sensing, 0.0, u)
+
+    def decide(likely):
+        return guard(believed, 0.0, (5.0, 5.0, 0.0, 1.0, 0.0), limits, ref, 100, ref.length,
+                     1.0, 0.1, 0.9021, True, likely=likely)
+
+    blind = decide(None)
+    assert blind.danger and blind.manoeuvre.speed == 0.0, blind  # brakes in its way
+    d = decide(likely_worlds(believed, base, sensing, 0.0, seen))
+    assert d.danger and d.manoeuvre.steer is not None and d.manoeuvre.steer < 0.0, d

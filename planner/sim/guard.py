@@ -32,6 +32,7 @@ import numpy as np
 from planner._world import (CONTACT, REACH, VMAX_OBS, World, path_clearances,
                             path_moving_clearances)
 from planner.sim.control import CUSP_REACH, Reference, Tracker
+from planner.sim.predict import without_growth
 from planner.sim.vehicle import Limits, toward
 
 __all__ = ["BACK_OFF", "FOLLOW", "STAND", "Decision", "Manoeuvre", "guard"]
@@ -99,14 +100,12 @@ class _Rollouts:
 
     def __init__(self, world: World, margin: float, state, limits: Limits,
                  ref: Reference | None, i: int, stop_s: float, rho: float,
-                 done_s: float, tracker: Tracker) -> None:
+                 done_s: float, tracker: Tracker, likely: list[World] | None) -> None:
         self.world, self.margin, self.limits, self.ref, self.stop_s = (world, margin, limits,
                                                                       ref, stop_s)
         self.state, self.tracker = state, tracker
         self.reachable: World | None = None  # reachable sets the car must be at rest before
-        likely = world.m_grow.copy()
-        likely[:, 1:3] = 0.0  # no growth: each mover where its sensed velocity takes it
-        self.likely = world._replace(m_grow=likely)
+        self.likely = likely or [without_growth(world)]
         self.x, self.y, self.th, self.v, self.steer = state
         self.s0 = float(ref.s[i]) if ref is not None else 0.0
         self.done_s = done_s if self.s0 < done_s else math.inf  # missed it: check on
@@ -192,8 +191,11 @@ class _Rollouts:
         if len(bad) == 0:
             return Outcome(math.inf, True)
         k = bad[0]
-        likely = np.flatnonzero(_unsure(path_moving_clearances(self.likely, samples),
-                                        closing) | static)
+        hit = static.copy()  # by the first of the likely futures to reach the car
+        for world in self.likely:
+            hit |= _unsure(path_moving_clearances(world, samples),
+                           drive + world.geo[VMAX_OBS] * STEP)
+        likely = np.flatnonzero(hit)
         j = likely[0] if len(likely) else k
         return Outcome(float(self.t[k]), max(abs(vs[j]), abs(vs[j + 1])) < 1e-9,
                        float(self.t[likely[0]]) if len(likely) else math.inf)
@@ -256,7 +258,8 @@ def _unstick(r: _Rollouts, cruise: float, commit: float, reverse: bool,
 def guard(world: World, margin: float, state, limits: Limits, ref: Reference | None, i: int,
           stop_s: float, cruise: float, commit: float, rho: float, reverse: bool,
           stuck: bool = False, done_s: float = math.inf, reach: World | None = None,
-          tracker: Tracker | None = None, back_off: bool = True) -> Decision:
+          tracker: Tracker | None = None, back_off: bool = True,
+          likely: list[World] | None = None) -> Decision:
     """The car's manoeuvre until the next decision, ``commit`` s from now.
 
     ``state``: (x, y, θ, v, δ) now; ``ref``/``i``: the plan and the car's row on it (None: no
@@ -272,10 +275,12 @@ def guard(world: World, margin: float, state, limits: Limits, ref: Reference | N
     reaches it; if only that fails, the car brakes along the plan (a walker may turn into
     it). Getting unstuck and the evasive manoeuvres are judged without them;
     ``tracker``: the controller the car tracks the plan with (None: pure pursuit at 100 Hz),
-    rolled out along it.
+    rolled out along it; ``likely``: the movers' likely futures, inflated like ``world``, by
+    which the manoeuvres in danger are ranked (None: ``world`` without its growth; see
+    `planner.sim.predict.likely_worlds`).
     """
     r = _Rollouts(world, margin, state, limits, ref, i, stop_s, rho, done_s,
-                  tracker or Tracker())
+                  tracker or Tracker(), likely)
     tried: list[tuple[Outcome, Manoeuvre]] = []
     if stuck:
         unstick = _unstick(r, cruise, commit, reverse, back_off)

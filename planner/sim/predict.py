@@ -37,7 +37,8 @@ from planner.problem import resolve_track
 from planner.sim.sensing import Sensing
 
 __all__ = ["HORIZON_S", "REACH_S", "Agility", "Lanes", "Uncertainty", "believed_offsets",
-           "predicted_world", "reach_rates", "reach_world"]
+           "likely_worlds", "predicted_world", "reach_rates", "reach_world", "turn_velocities",
+           "without_growth"]
 
 HORIZON_S = 1.0e4  # the predicted straight line is long enough for any run
 LANE_SPACING = 0.05  # m between the centreline samples a lane prediction follows
@@ -178,12 +179,15 @@ def predicted_world(base: World, sensing: Sensing, t0: float,
 class Agility:
     """What the car has seen each mover (per motion) do: the fastest it went, and whether it
     ever changed its velocity faster than the `Uncertainty` allows between two sensings — a
-    walker turning at once at a waypoint, a shuttle reversing, a walker setting off."""
+    walker turning at once at a waypoint, a shuttle reversing, a walker setting off — and
+    whether it did so at the latest sensing (``jumped``, from velocity ``before``)."""
 
     fastest: np.ndarray
     turned: np.ndarray
     last_t: float = math.nan  # the previous sensing's time and velocities
     last_velocities: np.ndarray | None = None
+    jumped: np.ndarray | None = None
+    before: np.ndarray | None = None
 
     @classmethod
     def none(cls, n: int) -> Agility:
@@ -194,8 +198,57 @@ class Agility:
         if self.last_velocities is not None:
             jump = np.hypot(*(sensing.velocities - self.last_velocities).T)
             allowed = uncertainty.accel * (sensing.t - self.last_t) + 2.0 * uncertainty.speed_error
-            self.turned |= jump > allowed + 1e-9
+            self.jumped, self.before = jump > allowed + 1e-9, self.last_velocities
+            self.turned |= self.jumped
         self.last_t, self.last_velocities = sensing.t, sensing.velocities
+
+
+TURN_SHARES = (0.5, 1.0)  # where on its ray a just-turned mover's new velocity is tried
+
+
+def turn_velocities(sensing: Sensing, agility: Agility, known=None) -> list[np.ndarray]:
+    """The velocities the movers that jumped at this sensing (`Agility.jumped`) may have now,
+    besides the sensed one, each a full (n_motions, 2) array.
+
+    A finite difference across a turn blends the velocities before and after it: the sensed
+    v̂ = (1 − w)·v₀ + w·v₁, w the unknown share of the interval after the turn. So v₁ lies on
+    the ray from v₀ through v̂, at or beyond v̂, and no faster than the mover has been seen to
+    go: a walker that turned back mid-interval is sensed standing, and is tried walking back
+    at its speed (`TURN_SHARES` of the way from v̂ to that end of the ray)."""
+    if agility.jumped is None:
+        return []
+    who = agility.jumped if known is None else agility.jumped & ~np.asarray(known, bool)
+    if not who.any():
+        return []
+    v0, v, top = agility.before[who], sensing.velocities[who], agility.fastest[who]
+    d = v - v0
+    # |v0 + k·d| = top, k ≥ 1: the ray's far end at the mover's top speed
+    dd, vd, vv = (np.einsum("ij,ij->i", a, b) for a, b in ((d, d), (v0, d), (v0, v0)))
+    k = (-vd + np.sqrt(np.maximum(vd * vd - dd * (vv - top * top), 0.0))) / np.maximum(dd, 1e-18)
+    out = []
+    for share in TURN_SHARES:
+        alt = sensing.velocities.copy()
+        alt[who] = v + share * (np.maximum(k, 1.0) - 1.0)[:, None] * d
+        out.append(alt)
+    return out
+
+
+def without_growth(world: World) -> World:
+    """``world``'s movers where their predictions take them, not grown: their likely futures."""
+    grow = world.m_grow.copy()
+    grow[:, 1:3] = 0.0
+    return world._replace(m_grow=grow)
+
+
+def likely_worlds(believed: World, base: World, sensing: Sensing, t0: float, agility: Agility,
+                  known=None, lanes: Lanes | None = None) -> list[World]:
+    """The movers' likely futures: ``believed`` (`predicted_world`) without its growth, and
+    one world more for each velocity a mover that just turned may have now
+    (`turn_velocities`)."""
+    return [without_growth(believed)] + [
+        without_growth(predicted_world(base, Sensing(sensing.t, sensing.offsets, v), t0,
+                                       known=known, lanes=lanes))
+        for v in turn_velocities(sensing, agility, known)]
 
 
 def reach_rates(agility: Agility, uncertainty: Uncertainty = Uncertainty(), known=None,

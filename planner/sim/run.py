@@ -33,6 +33,7 @@ from planner.sim.predict import (
     Agility,
     Lanes,
     Uncertainty,
+    likely_worlds,
     predicted_world,
     reach_rates,
     reach_world,
@@ -193,6 +194,7 @@ def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertain
     ``known``: per motion, whether its timetable is known (`known_motions`)."""
     believed = predicted_world(problem.world, sensing, t, uncertainty, known, lanes)
     reach = reach_world(problem.world, sensing, t, agility, uncertainty, known, lanes)
+    likely = likely_worlds(believed, problem.world, sensing, t, agility, known, lanes)
     margin = GUARD_MARGIN * s.margin
     margin = margin if clearance(believed, state[0], state[1], 0.0) > margin else 0.0
     i = ref.project(state[0], state[1])[0] if ref is not None else 0
@@ -200,7 +202,8 @@ def _decide(problem: Problem, sensing: Sensing, t: float, uncertainty: Uncertain
         ref = None  # the car is not where the plan is: checks along it would be fiction
     return guard(inflated(believed, margin), margin, state, limits, ref, i, stop_s, cruise,
                  commit, problem.rho, s.reverse, stuck, done_s,
-                 inflated(reach, margin) if reach is not None else None, tracker, back_off)
+                 inflated(reach, margin) if reach is not None else None, tracker, back_off,
+                 [inflated(w, margin) for w in likely])
 
 
 def _lap_counter(scenario: Scenario, problem: Problem, s: SimSettings, load_track):
