@@ -283,9 +283,6 @@ def test_a_stop_in_a_movers_likely_path_ranks_below_leaving_it():
     # Fenced in by walkers standing where their walks end, each believed grown 1.3 m (T = 1.5
     # s then): no plan for the last 18 s.
     ("crowd_square", 10, "constant", 0),
-    # Set off from rest past the parked box, behind a plan timed at cruise speed from its
-    # root: the box's growing prediction caught the car the plan had put further on.
-    ("back_up", 10, "constant", 5),
 ])
 def test_runs_that_failed_before(name, rate, timing, seed):
     run = simulate(planner.load_scenario(name),

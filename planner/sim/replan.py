@@ -104,13 +104,8 @@ class Replanner:
         v = v * self.reference.direction if self.reference is not None else v
         commit = max(v, 0.0) * (lead_s + swing) + 0.5 * a * lead_s ** 2 if v > 1e-9 else 0.0
         root, anchor, skip, s_c = self._commit_point(pose, s_now, commit)
-        # A plan is timed at the cruise speed from its root; a car slower than that falls
-        # behind it by the time it loses getting up to speed, so the movers are believed from
-        # that much later on (a parked mover's prediction has grown by then).
-        speed = self.options.speed
-        lag = (speed - max(v, 0.0)) ** 2 / (2.0 * a * speed) if v < speed else 0.0
-        believed = predicted_world(self.problem.world, sensing, t + lead_s + lag,
-                                   self.uncertainty, self.known, self.lanes)
+        believed = predicted_world(self.problem.world, sensing, t + lead_s, self.uncertainty,
+                                   self.known, self.lanes)
         plan_world = inflated(believed, self.margin)
         if clearance(plan_world, root[0], root[1], 0.0) <= 0.0:
             plan_world = believed  # already inside the margin: plan with the bare disc
