@@ -72,7 +72,7 @@ class SimOptions(KnownKeys):
     predict_horizon: Annotated[float, Field(ge=0, le=MAX_PREDICT_HORIZON_S,
                                             allow_inf_nan=False)] | None = Field(
         None, description="s of look-ahead over which the predictions grow; held beyond "
-                          "(default: the scenario's prediction.horizon, else 1.0)")
+                          "(default: the scenario's prediction.horizon, else 1.5)")
     reverse: bool = Field(True, description="the car may back up to evade a mover")
     steering: CarSteering = Field(
         DEFAULT_STEERING, description="the replanner's steering: " + "; ".join(

@@ -252,13 +252,11 @@ def test_log_replays_and_respects_the_limits(crossing_run):
 @pytest.mark.parametrize("scene", ["stop_in_lane", "back_up"])
 def test_replanning_passes_movers_a_blind_plan_hits(scene):
     """A mover stops (or backs up) in the lane: the replanning car passes it, the car that
-    follows its t = 0 plan collides — recounted independently from the log. (Seed 7: with
-    predictions widening over 1 s, `back_up`'s car misses the goal in 7 of 40 runs, seed 2
-    among them, held beside the parked box; docs/simulation.md.)"""
-    scn, run = _run(scene, duration=30.0, seed=7)
+    follows its t = 0 plan collides — recounted independently from the log."""
+    scn, run = _run(scene, duration=30.0, seed=2)
     assert run.summary["reached_goal"] and run.summary["collisions"] == 0
     assert _independent_collisions(scn, run.log) == 0
-    _, blind = _run(scene, duration=22.0, seed=7, replan=False)
+    _, blind = _run(scene, duration=22.0, seed=2, replan=False)
     assert blind.summary["collisions"] >= 1
     assert _independent_collisions(scn, blind.log) == blind.summary["collisions"]
     assert blind.summary["min_clearance_m"] < 0

@@ -47,7 +47,7 @@ def simulate(
              "Default: the scenario's prediction.speed_error, else 0.1.")] = None,
     predict_horizon: Annotated[float | None, typer.Option(
         help="s of look-ahead over which the predictions grow; held beyond. Default: the "
-             "scenario's prediction.horizon, else 1.0.")] = None,
+             "scenario's prediction.horizon, else 1.5.")] = None,
     reverse: Annotated[bool, typer.Option(
         help="The car may back up to evade a mover.")] = True,
     steering: Annotated[str, typer.Option(

@@ -57,7 +57,7 @@ class Uncertainty:
 
     accel: float = 1.0  # m/s²: the most a mover changes its velocity per second
     speed_error: float = 0.1  # m/s: the most the sensed velocity is off
-    horizon: float = 1.0  # s of look-ahead over which the growth widens; held beyond
+    horizon: float = 1.5  # s of look-ahead over which the growth widens; held beyond
 
     def __post_init__(self) -> None:
         for name in ("accel", "speed_error", "horizon"):
