@@ -545,3 +545,31 @@ def test_a_walker_sensed_mid_turn_is_not_braked_for_in_its_way_back():
     assert blind.danger and blind.manoeuvre.speed == 0.0, blind  # brakes in its way
     d = decide(likely_worlds(believed, base, sensing, 0.0, seen))
     assert d.danger and d.manoeuvre.steer is not None and d.manoeuvre.steer < 0.0, d
+
+
+def test_a_walker_turning_at_the_car_is_dashed_away_from_not_stood_for():
+    """A fresh square (`bench_crowd_variants.py --seed 36`, `square_new1`, 10 and 30 Hz,
+    constant, seed 2): a walker turned at its first waypoint, 1.5 m from the car, and walked
+    straight at it. The swerves at the car's speed (0.6 m/s) and going on straight were all met
+    by its likely future, so the car stood in its way and was walked into at rest. Swerving
+    while speeding up (`dash-left`) gets out of the way: the car, driven as the simulator
+    drives it, stays clear of the walker's true straight walk."""
+    from planner.sim.guard import guard
+    from planner.sim.predict import Agility, likely_worlds
+    from planner.sim.vehicle import arc_step, limit_commands
+
+    base, ref, limits = _lane()
+    walker, velocity = np.array([6.04, 3.98]), np.array([-0.57, 0.79])  # 1.1 m ahead, right
+    sensing = _walker(0.0, walker, velocity)
+    believed = predicted_world(base, sensing, 0.0)
+    d = guard(believed, 0.0, (5.0, 5.0, 0.0, 0.6, 0.0), limits, ref, 100, ref.length, 1.0, 0.1,
+              0.9021, True, likely=likely_worlds(believed, base, sensing, 0.0, Agility.none(1)))
+    m = d.manoeuvre
+    assert d.danger and m.steer is not None and m.speed == limits.max_speed, d
+    x, y, th, v, steer, dt, least = 5.0, 5.0, 0.0, 0.6, 0.0, 0.01, math.inf
+    for k in range(600):
+        v, steer = limit_commands(v, steer, m.speed if k * dt < m.hold else 0.0, m.steer,
+                                  limits, dt)
+        x, y, th = arc_step(x, y, th, v, steer, limits.wheelbase, dt)
+        least = min(least, math.dist((x, y), walker + velocity * (k + 1) * dt) - 0.5)
+    assert least > 0.1, least

@@ -10,8 +10,9 @@ Each cycle the guard tries, fastest first, to go on along the plan at a speed ca
 cycle (the commitment) followed by a fallback: brake along the plan, or drive on along it for a
 while and brake then. The first cap with a clear fallback is what the car drives. If none is
 clear, the car is in danger: the guard picks, from the state now, the manoeuvre that stays
-clear longest — brake along the plan, brake while swerving, swerve at speed, go on straight, or
-back up — and the car executes it until the next cycle decides again.
+clear longest — brake along the plan, brake while swerving, swerve at speed, go on straight,
+or back up; and where each of these stays in a mover's likely way, dash aside — and the car
+executes it until the next cycle decides again.
 
 Rollouts are the car's own model (exact arcs with the actuator limits, at ``STEP`` s); along
 the plan it is the tracking controller rolled out from where the car is (`control.Tracker`), so
@@ -232,6 +233,15 @@ def _evasive(v: float, cruise: float, limits: Limits, reverse: bool) -> list[Man
     return evasive
 
 
+def _dashes(limits: Limits) -> list[Manoeuvre]:
+    """The last resort when every other manoeuvre stays in the way of a mover's likely future
+    (a walker that turns at the car 1.5 m off: a swerve at the car's speed is too slow):
+    steering fully aside while speeding up to the top speed. Tried only then, since it leaves
+    the car moving fast where a stop would have been clear of the likely futures."""
+    return [Manoeuvre(f"dash-{side}", limits.max_speed, EVADE_S, sign * limits.max_steer)
+            for side, sign in (("left", 1.0), ("right", -1.0))]
+
+
 def _unstick(r: _Rollouts, cruise: float, commit: float, reverse: bool,
              back_off: bool) -> Decision | None:
     """A car that has stood a while, not by plan, gets going, judged without the reachable
@@ -310,5 +320,8 @@ def guard(world: World, margin: float, state, limits: Limits, ref: Reference | N
     r.reachable = None
     for m in _evasive(r.v, cruise, limits, reverse):
         tried.append((r.free(m), m))
+    if all(out.likely_s < math.inf for out, _ in tried):  # each one stays in a mover's way
+        for m in _dashes(limits):
+            tried.append((r.free(m), m))
     out, m = max(tried, key=lambda om: om[0].rank)  # the first of the best
     return Decision(m, out.clear_s, True)
