@@ -10,7 +10,10 @@ space-time plan to the goal exists.
   to 1 m along its way;
 * pedestrian crossings of 6–8 walkers at 0.7–1.5 m/s that cross, pause on the zebra, turn back
   halfway, or turn back at once 0.8–2.5 m in;
-* open squares of 8–10 walkers on six random legs at 0.6–1.3 m/s, pausing between some.
+* open squares of 8–10 walkers on six random legs at 0.6–1.3 m/s, pausing between some;
+* warehouses of random aisles, each cross aisle a dead end at the wall with a shuttle that
+  reverses and dwells (`warehouse`);
+* merges into, and overtakes against, streams of movers at random speeds and gaps.
 
 Then drives each through `trackstar simulate FILE --rate R --timing T --seed K --fixed-latency
 20 --json` (R 10 and 30 Hz, both timings, K = 0..seeds−1) and writes, per scene, the runs with a
@@ -18,7 +21,7 @@ collision while moving, at rest, and the goals reached, to benchmarks/results/cr
 
     python benchmarks/bench_crowd_variants.py [--seed 33] [--count 2] [--seeds 3] [--jobs 2]
 
-About 15 minutes with the defaults (14 scenes, 168 runs) on a 2-core machine.
+About 25 minutes with the defaults (20 scenes, 240 runs) on a 2-core machine.
 """
 
 from __future__ import annotations
@@ -119,6 +122,70 @@ def square(rng: random.Random) -> dict:
             "goal": [18.5, 18.5, 0.785398], "obstacles": walkers}
 
 
+def warehouse(rng: random.Random) -> dict:
+    """Shelf rows either side of a 3.6–5 m main aisle, cut by 2–4 cross aisles 2–2.4 m wide that
+    end at the walls; in each a shuttle (1 × 0.8 m) runs at 0.7–1.3 m/s to the aisle's other end
+    or into the main aisle's middle and back, dwelling 1–3 s at each stop."""
+    aisle, depth, length = rng.uniform(3.6, 5.0), rng.uniform(2.5, 4.0), rng.uniform(22.0, 30.0)
+    height, n = aisle + 2.0 * depth, rng.randint(2, 4)
+    slot = (length - 8.0) / n
+    cuts = [(x - w / 2, x + w / 2) for x, w in
+            ((6.0 + slot * (i + rng.uniform(0.3, 0.7)), rng.uniform(2.0, 2.4)) for i in range(n))]
+    edges = [round(x, 2) for x in [0.0, *(x for cut in cuts for x in cut), length]]
+    shelves = [{"type": "polygon", "points": [[a, y0], [b, y0], [b, y1], [a, y1]]}
+               for a, b in zip(edges[::2], edges[1::2])
+               for y0, y1 in ((0.0, round(depth, 2)), (round(depth + aisle, 2), round(height, 2)))]
+    shuttles = []
+    for a, b in cuts:
+        bottom = rng.random() < 0.5
+        y_start = 0.5 if bottom else height - 0.5
+        ends = (0.0, (height - 1.0) * (1 if bottom else -1))  # offsets from where it starts
+        middle, v = depth + aisle / 2 - y_start, rng.uniform(0.7, 1.3)
+        t, at = rng.uniform(0.0, 10.0), 0.0
+        way = [[0.0, 0.0, 0.0], [round(t, 3), 0.0, 0.0]]
+        while t < 75.0:
+            far = ends[1] if at == ends[0] else ends[0]
+            stops = [middle, at] if rng.random() < 0.3 else [far]
+            for stop in stops:
+                t += abs(stop - at) / v
+                way.append([round(t, 3), 0.0, round(stop, 2)])
+                t += rng.uniform(1.0, 3.0)
+                way.append([round(t, 3), 0.0, round(stop, 2)])
+                at = stop
+        shuttles.append({"type": "box", "center": [round((a + b) / 2, 2), round(y_start, 2)],
+                         "size": [1.0, 0.8], "motion": {"waypoints": way}})
+    mid = round(depth + aisle / 2, 2)
+    return {"bounds": [0, 0, round(length, 2), round(height, 2)], **CAR,
+            "start": [1.0, mid, 0.0], "goal": [round(length - 1.0, 2), mid, 0.0],
+            "obstacles": shelves + shuttles}
+
+
+def merge(rng: random.Random) -> dict:
+    """An on-ramp into a 3 m lane (the bundled merge's road) where 6–8 discs drive at one speed
+    of 0.8–1.3 m/s, 4.5–9 m apart."""
+    road = json.loads(planner.bundled_scenario_path("crowd_merge").read_text())
+    v, x, discs = rng.uniform(0.8, 1.3), rng.uniform(6.0, 12.0), []
+    for _ in range(rng.randint(6, 8)):
+        discs.append({"type": "circle", "center": [round(x, 2), 6.0], "radius": 0.35,
+                      "motion": {"velocity": [round(v, 3), 0.0]}})
+        x -= rng.uniform(4.5, 9.0)
+    return {**road, "obstacles": [ob for ob in road["obstacles"] if "motion" not in ob] + discs}
+
+
+def overtake(rng: random.Random) -> dict:
+    """The bundled overtaking road: a cart at 0.3–0.45 m/s in the car's lane, discs coming the
+    other way at 0.8–1.2 m/s, 14–26 m apart."""
+    road = json.loads(planner.bundled_scenario_path("crowd_overtake").read_text())
+    cart = {"type": "box", "center": [round(rng.uniform(4.0, 7.0), 2), 1.5], "size": [1.2, 0.8],
+            "motion": {"velocity": [round(rng.uniform(0.3, 0.45), 3), 0.0]}}
+    v, x, discs = rng.uniform(0.8, 1.2), rng.uniform(12.0, 22.0), []
+    while x < 100.0:
+        discs.append({"type": "circle", "center": [round(x, 2), 4.5], "radius": 0.4,
+                      "motion": {"velocity": [-round(v, 3), 0.0]}})
+        x += rng.uniform(14.0, 26.0)
+    return {**road, "obstacles": [cart, *discs]}
+
+
 def fair(scene: dict) -> bool:
     """Waiting at the start is free for 60 s, and a space-time plan to the goal exists (one of
     three seeds, 3 s each), both by the independent checker."""
@@ -137,7 +204,8 @@ def scenes(seed: int, count: int) -> dict[str, dict]:
     rng, out = random.Random(seed), {}
     makers = [(f"{name}_v", lambda r, n=name: varied(
         json.loads(planner.bundled_scenario_path(n).read_text()), r)) for name in CROWDS]
-    makers += [("crossing_new", crossing), ("square_new", square)]
+    makers += [("crossing_new", crossing), ("square_new", square), ("warehouse_new", warehouse),
+               ("merge_new", merge), ("overtake_new", overtake)]
     for prefix, make in makers:
         made = 0
         while made < count:
