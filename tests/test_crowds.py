@@ -573,3 +573,35 @@ def test_a_walker_turning_at_the_car_is_dashed_away_from_not_stood_for():
         x, y, th = arc_step(x, y, th, v, steer, limits.wheelbase, dt)
         least = min(least, math.dist((x, y), walker + velocity * (k + 1) * dt) - 0.5)
     assert least > 0.1, least
+
+
+def test_the_car_does_not_evade_into_a_dead_end_a_shuttle_comes_up():
+    """A fresh warehouse (`bench_crowd_variants.py --seed 36`, `crowd_warehouse_v0`, 10 Hz,
+    constant, seed 1): a shuttle set off up the cross aisle the car was about to pass. Its grown
+    prediction met every way on along the main aisle within the 4 s horizon; only swerving up
+    the cross aisle, a dead end, kept clear of it that long. The car took it, evaded further up
+    each cycle, and stood at the aisle's end until the shuttle came (−0.14 m, at rest). Going on
+    along the aisle keeps clear of the shuttle's likely future and stops where it never comes,
+    and the car, driven on, passes the shuttle's true motion with room to spare."""
+    from planner.sim.guard import guard
+    from planner.sim.predict import Agility, likely_worlds
+
+    def box(x0, y0, x1, y1):
+        return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], float)
+
+    shelves = [(box(x0, y0, x1, y1), -1) for x0, x1 in ((0, 6), (8, 13), (15, 20), (22, 26))
+               for y0, y1 in ((0, 3.2), (8.8, 12))]
+    base = build_world((0, 0, 26, 12), 0.2, [], [*shelves, (box(13.5, 0.6, 14.5, 1.4), 0)],
+                       [("velocity", (0.0, 0.0))])
+    _, ref, limits = _lane()
+    ref = type(ref)(ref.rows + [0.0, 0.5, 0.0, 0.0, 0.0])  # along the main aisle, y = 5.5
+    sensing = _walker(0.0, (0.0, 0.1), (0.0, 0.83))  # the shuttle, just set off up the aisle
+    believed = predicted_world(base, sensing, 0.0)
+    d = guard(believed, 0.0, (12.63, 5.5, 0.0, 1.0, 0.0), limits, ref, 252, ref.length, 1.0,
+              0.1, 0.9021, True,
+              likely=likely_worlds(believed, base, sensing, 0.0, Agility.none(1)))
+    assert d.on_plan and d.manoeuvre.speed == 1.0, d  # on along the aisle, not up the cross one
+    t = np.arange(0.0, 8.0, 0.01)
+    gap_x = np.maximum(np.abs(12.63 + t - 14.0) - 0.5, 0.0)  # car on at 1 m/s; shuttle's box
+    gap_y = np.maximum(np.abs(5.5 - (1.1 + 0.83 * t)) - 0.4, 0.0)
+    assert np.hypot(gap_x, gap_y).min() - 0.2 > 1.0

@@ -12,7 +12,9 @@ while and brake then. The first cap with a clear fallback is what the car drives
 clear, the car is in danger: the guard picks, from the state now, the manoeuvre that stays
 clear longest — brake along the plan, brake while swerving, swerve at speed, go on straight,
 or back up; and where each of these stays in a mover's likely way, dash aside — and the car
-executes it until the next cycle decides again.
+executes it until the next cycle decides again. Where every manoeuvre clear throughout ends at
+rest where a likely future comes soon after the horizon (a dead end a shuttle comes up), those
+clear of the likely futures come first.
 
 Rollouts are the car's own model (exact arcs with the actuator limits, at ``STEP`` s); along
 the plan it is the tracking controller rolled out from where the car is (`control.Tracker`), so
@@ -43,6 +45,7 @@ HORIZON = 4.0  # s checked ahead, the car at rest at its end
 CAPS = (1.0, 0.5, 0.0)  # commit speed caps, as shares of the cruise speed, tried in order
 GO_ON = (0.0, 1.0, 2.0)  # s driven on along the plan after the commitment before braking
 EVADE_S = 1.0  # s an evasive manoeuvre holds its speed before it brakes
+REFUGE_S, REFUGE_STEP = 4.0, 0.1  # s after the horizon a rest pose is checked on, and how often
 FOLLOW, STAND = "follow", "stand"  # along the plan at cruise; no plan: at rest where it is
 BACK_OFF, UNSTICK_S = "back-off", 2.0  # stuck: back up at half the cruise speed this long
 
@@ -62,11 +65,13 @@ class Outcome(NamedTuple):
     """How a rollout fares: clear of the grown predictions for ``clear_s`` (inf: the whole
     horizon), clear of the likely futures (constant velocity, not grown) for ``likely_s``, and
     whether the car stands still where it may first be hit — by a likely future where one hits
-    it — (passive safety: then the contact is not its own)."""
+    it — (passive safety: then the contact is not its own); ``end``: the pose it rests in at
+    the horizon (None: the run ends in the goal before)."""
 
     clear_s: float
     at_rest: bool
     likely_s: float = math.inf
+    end: tuple[float, float, float] | None = None
 
     @property
     def rank(self):
@@ -119,6 +124,7 @@ class _Rollouts:
         widening = np.where(tau < horizon, e_v + a * np.maximum(tau, 0.0), 0.0)
         self.closing = (world.geo[VMAX_OBS] - (e_v + a * horizon) + widening) * STEP
         self.reach = 1.0 + world.geo[REACH] / rho
+        self.later = HORIZON + REFUGE_STEP * np.arange(1, int(round(REFUGE_S / REFUGE_STEP)) + 1)
 
     def along(self, cap: float, hold: float) -> Outcome:
         """Clear time of: along the plan at speed ``cap`` for ``hold`` s, then braking; never
@@ -189,8 +195,9 @@ class _Rollouts:
             unsure |= moving & _unsure(path_moving_clearances(self.reachable, samples),
                                        drive + self.reachable.geo[VMAX_OBS] * STEP)
         bad = np.flatnonzero(unsure)
+        end = tuple(poses[-1]) if n == self.n else None
         if len(bad) == 0:
-            return Outcome(math.inf, True)
+            return Outcome(math.inf, True, end=end)
         k = bad[0]
         hit = static.copy()  # by the first of the likely futures to reach the car
         for world in self.likely:
@@ -199,7 +206,21 @@ class _Rollouts:
         likely = np.flatnonzero(hit)
         j = likely[0] if len(likely) else k
         return Outcome(float(self.t[k]), max(abs(vs[j]), abs(vs[j + 1])) < 1e-9,
-                       float(self.t[likely[0]]) if len(likely) else math.inf)
+                       float(self.t[likely[0]]) if len(likely) else math.inf, end)
+
+    def refuge(self, out: Outcome) -> bool:
+        """Whether a rollout clear throughout ends in the goal, or at rest where no likely
+        future comes for `REFUGE_S` after the horizon either. A car that evades into a dead end
+        stands clear of a shuttle coming up it for the horizon, and is run into at rest after
+        it, with no way out."""
+        if out.end is None:
+            return True
+        samples = np.zeros((len(self.later), 6))
+        samples[:, :3] = out.end
+        samples[:, 5] = self.later
+        steps = np.full(len(self.later) - 1, REFUGE_STEP)
+        return not any(_unsure(path_moving_clearances(world, samples),
+                               world.geo[VMAX_OBS] * steps).any() for world in self.likely)
 
 
 def _unsure(c: np.ndarray, drop: np.ndarray) -> np.ndarray:
@@ -323,5 +344,11 @@ def guard(world: World, margin: float, state, limits: Limits, ref: Reference | N
     if all(out.likely_s < math.inf for out, _ in tried):  # each one stays in a mover's way
         for m in _dashes(limits):
             tried.append((r.free(m), m))
-    out, m = max(tried, key=lambda om: om[0].rank)  # the first of the best
-    return Decision(m, out.clear_s, True)
+    # Where every way clear throughout ends in a trap (`_Rollouts.refuge`), a way clear of the
+    # likely futures comes first: going on past a shuttle beats evading into the dead end it
+    # comes up.
+    clear = [out for out, _ in tried if out.clear_s == math.inf]
+    trapped = bool(clear) and not any(r.refuge(out) for out in clear)
+    out, m = max(tried, key=lambda om: (trapped and om[0].clear_s < math.inf
+                                        and om[0].likely_s == math.inf, *om[0].rank))
+    return Decision(m, out.clear_s, True)  # the first of the best
