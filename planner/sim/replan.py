@@ -90,8 +90,10 @@ class Replanner:
 
     # -- the cycle ---------------------------------------------------------------------------
     def cycle(self, t: float, sensing: Sensing, pose, v: float, s_now: float,
-              lead_s: float) -> Cycle:
-        """Plan from the state the car will be in ``lead_s`` seconds after t."""
+              lead_s: float, spent_s: float = 0.0) -> Cycle:
+        """Plan from the state the car will be in ``lead_s`` seconds after t. ``spent_s``: time
+        this cycle has already taken (the guard's check), off the planning budget — at most
+        half of it, so that a car in danger still gets a plan."""
         started = time.perf_counter()
         self.count += 1
         vehicle = self.problem.scenario.vehicle
@@ -114,7 +116,8 @@ class Replanner:
             free = [g for g in self.goals if clearance(plan_world, g[0], g[1], 0.0) > 0.0]
             self.problem = dataclasses.replace(self.problem, goal=(free or self.goals)[0])
         old, old_cost = self.planner, self._remaining_cost(s_c)
-        planner, waits = self._plan(plan_world, root, old, anchor, skip, started)
+        spent_s = min(spent_s, 0.5 * self.budget_s) if self.budget_s else 0.0
+        planner, waits = self._plan(plan_world, root, old, anchor, skip, started - spent_s)
         replaced = False
         self.shift = 0.0
         if planner.solved:

@@ -336,7 +336,7 @@ def simulate(scenario: Scenario, settings: SimSettings | None = None,
                     replanner, ref, conflict = new_replanner(), None, False
             checked = time.perf_counter() - checked
             s_now = ref.s[ref.project(est[0], est[1])[0]] if ref is not None else 0.0
-            cyc = replanner.cycle(t, sensing, est, v, s_now, lead)
+            cyc = replanner.cycle(t, sensing, est, v, s_now, lead, checked)
             latency = fixed if fixed is not None else cyc.wall_s + checked
             walls.append(latency)
             cycles.append({"t": t, "ms": (cyc.wall_s + checked) * 1000.0,
