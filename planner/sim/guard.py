@@ -46,6 +46,7 @@ CAPS = (1.0, 0.5, 0.0)  # commit speed caps, as shares of the cruise speed, trie
 GO_ON = (0.0, 1.0, 2.0)  # s driven on along the plan after the commitment before braking
 EVADE_S = 1.0  # s an evasive manoeuvre holds its speed before it brakes
 REFUGE_S, REFUGE_STEP = 4.0, 0.1  # s after the horizon a rest pose is checked on, and how often
+_REFUGE_T = HORIZON + REFUGE_STEP * np.arange(1, int(round(REFUGE_S / REFUGE_STEP)) + 1)
 FOLLOW, STAND = "follow", "stand"  # along the plan at cruise; no plan: at rest where it is
 BACK_OFF, UNSTICK_S = "back-off", 2.0  # stuck: back up at half the cruise speed this long
 
@@ -124,7 +125,6 @@ class _Rollouts:
         widening = np.where(tau < horizon, e_v + a * np.maximum(tau, 0.0), 0.0)
         self.closing = (world.geo[VMAX_OBS] - (e_v + a * horizon) + widening) * STEP
         self.reach = 1.0 + world.geo[REACH] / rho
-        self.later = HORIZON + REFUGE_STEP * np.arange(1, int(round(REFUGE_S / REFUGE_STEP)) + 1)
 
     def along(self, cap: float, hold: float) -> Outcome:
         """Clear time of: along the plan at speed ``cap`` for ``hold`` s, then braking; never
@@ -215,10 +215,10 @@ class _Rollouts:
         it, with no way out."""
         if out.end is None:
             return True
-        samples = np.zeros((len(self.later), 6))
+        samples = np.zeros((len(_REFUGE_T), 6))
         samples[:, :3] = out.end
-        samples[:, 5] = self.later
-        steps = np.full(len(self.later) - 1, REFUGE_STEP)
+        samples[:, 5] = _REFUGE_T
+        steps = np.full(len(_REFUGE_T) - 1, REFUGE_STEP)
         return not any(_unsure(path_moving_clearances(world, samples),
                                world.geo[VMAX_OBS] * steps).any() for world in self.likely)
 
