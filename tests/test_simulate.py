@@ -272,7 +272,6 @@ def test_with_timing_optimal_the_car_waits_for_the_train():
     assert s["distance_m"] < 18.5  # straight on: no loop
 
 
-
 def test_the_guards_check_comes_off_the_planning_budget():
     """A cycle's guard check and its planning share one budget: the replanner plans for what
     the check left of it, at most half of it taken (a car in danger still gets a plan). Before,
@@ -293,6 +292,7 @@ def test_the_guards_check_comes_off_the_planning_budget():
 
     assert wall(0.0) >= 0.2
     assert wall(0.5) < 0.15  # half the budget taken, not all of it
+
 
 # -- the command line ----------------------------------------------------------------------
 def _cli(*args, timeout=120):
