@@ -291,7 +291,7 @@ def test_the_guards_check_comes_off_the_planning_budget():
         return replanner.cycle(0.0, sensing, problem.start, 0.0, 0.0, 0.1, spent_s).wall_s
 
     assert wall(0.0) >= 0.2
-    assert wall(0.5) < 0.15  # half the budget taken, not all of it
+    assert 0.1 <= wall(0.5) < 0.15  # half the budget taken, not all of it
 
 
 # -- the command line ----------------------------------------------------------------------
