@@ -160,10 +160,14 @@ def warehouse(rng: random.Random) -> dict:
             "obstacles": shelves + shuttles}
 
 
+def _bundled(name: str) -> dict:
+    return json.loads(planner.bundled_scenario_path(name).read_text())
+
+
 def merge(rng: random.Random) -> dict:
     """An on-ramp into a 3 m lane (the bundled merge's road) where 6–8 discs drive at one speed
     of 0.8–1.3 m/s, 4.5–9 m apart."""
-    road = json.loads(planner.bundled_scenario_path("crowd_merge").read_text())
+    road = _bundled("crowd_merge")
     v, x, discs = rng.uniform(0.8, 1.3), rng.uniform(6.0, 12.0), []
     for _ in range(rng.randint(6, 8)):
         discs.append({"type": "circle", "center": [round(x, 2), 6.0], "radius": 0.35,
@@ -175,7 +179,7 @@ def merge(rng: random.Random) -> dict:
 def overtake(rng: random.Random) -> dict:
     """The bundled overtaking road: a cart at 0.3–0.45 m/s in the car's lane, discs coming the
     other way at 0.8–1.2 m/s, 14–26 m apart."""
-    road = json.loads(planner.bundled_scenario_path("crowd_overtake").read_text())
+    road = _bundled("crowd_overtake")
     cart = {"type": "box", "center": [round(rng.uniform(4.0, 7.0), 2), 1.5], "size": [1.2, 0.8],
             "motion": {"velocity": [round(rng.uniform(0.3, 0.45), 3), 0.0]}}
     v, x, discs = rng.uniform(0.8, 1.2), rng.uniform(12.0, 22.0), []
@@ -202,8 +206,7 @@ def fair(scene: dict) -> bool:
 def scenes(seed: int, count: int) -> dict[str, dict]:
     """``count`` fair scenes of each kind, by name."""
     rng, out = random.Random(seed), {}
-    makers = [(f"{name}_v", lambda r, n=name: varied(
-        json.loads(planner.bundled_scenario_path(n).read_text()), r)) for name in CROWDS]
+    makers = [(f"{name}_v", lambda r, n=name: varied(_bundled(n), r)) for name in CROWDS]
     makers += [("crossing_new", crossing), ("square_new", square), ("warehouse_new", warehouse),
                ("merge_new", merge), ("overtake_new", overtake)]
     for prefix, make in makers:
